@@ -1,0 +1,398 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// orient_normals: the command-line program of Normal_orientation.
+//
+//   orient_normals [options] [IN [OUT]]
+//
+// Reads a point cloud (.xyz/.pwn or .ply), estimates normals when it has
+// none, orients them consistently and outward, and writes the result
+// (.xyz or .ply, by extension) through a temporary file and a rename, so
+// an output file is either complete or absent.
+
+#include <Normal_orientation/IO/Point_cloud_io.h>
+#include <Normal_orientation/orient_normals.h>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/jet_estimate_normals.h>
+#include <CGAL/pca_estimate_normals.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace NO = Normal_orientation;
+typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
+typedef Kernel::Point_3 Point;
+typedef Kernel::Vector_3 Vector;
+
+namespace {
+
+/// A bad command line: reported with the usage hint, exit status 2.
+struct Usage_error : std::runtime_error
+{
+  using std::runtime_error::runtime_error;
+};
+
+/// Reads the positions of a `Point_cloud` by index.
+struct Cloud_point_map
+{
+  typedef std::size_t key_type;
+  typedef Point value_type;
+  typedef Point reference;
+  typedef boost::readable_property_map_tag category;
+  const NO::IO::Point_cloud* cloud;
+  friend Point get(const Cloud_point_map& m, std::size_t i)
+  {
+    const auto& p = m.cloud->points[i];
+    return Point(p[0], p[1], p[2]);
+  }
+};
+
+/// Reads and writes the normals of a `Point_cloud` by index.
+struct Cloud_normal_map
+{
+  typedef std::size_t key_type;
+  typedef Vector value_type;
+  typedef Vector reference;
+  typedef boost::read_write_property_map_tag category;
+  NO::IO::Point_cloud* cloud;
+  friend Vector get(const Cloud_normal_map& m, std::size_t i)
+  {
+    const auto& n = m.cloud->normals[i];
+    return Vector(n[0], n[1], n[2]);
+  }
+  friend void put(const Cloud_normal_map& m, std::size_t i, const Vector& v)
+  {
+    m.cloud->normals[i] = {v.x(), v.y(), v.z()};
+  }
+};
+
+struct Options
+{
+  std::string input, output;
+  unsigned int k = 10;
+  double radius = 0.0;
+  std::string criterion = "hoppe";
+  std::string solver = "mst";
+  std::string sign = "outward";
+  bool has_viewpoint = false;
+  double viewpoint[3] = {0, 0, 0};
+  std::string normals = "jet";
+  unsigned int normal_k = 18;
+  int threads = 0;
+  unsigned long seed = 0;
+  bool json = false, quiet = false, ascii = false;
+};
+
+const char* usage_text =
+  "usage: orient_normals [options] [IN [OUT]]\n"
+  "\n"
+  "Orients the normals of a point cloud consistently and outward.\n"
+  "IN: .xyz/.pwn (x y z [nx ny nz] per line) or .ply (ascii or binary).\n"
+  "OUT: .xyz or .ply, by extension (default: IN with '_oriented' added).\n"
+  "Without IN, orients the sample cloud shipped with the library.\n"
+  "Normals are estimated first when IN has none.\n"
+  "\n"
+  "options:\n"
+  "  --k N                neighbours per point (default 10)\n"
+  "  --radius R           neighbour radius (default: estimated from the data)\n"
+  "  --criterion NAME     flip criterion: hoppe (default), xie, konig\n"
+  "  --solver NAME        solver: mst (default)\n"
+  "  --sign NAME          component sign: outward (default), keep\n"
+  "  --viewpoint X,Y,Z    make every component face this point instead\n"
+  "  --normals NAME       estimator when IN has no normals: jet (default), pca\n"
+  "  --normal-k N         neighbours of the normal estimator (default 18)\n"
+  "  --threads N          threads (default: all cores); results do not depend on it\n"
+  "  --seed S             random seed of randomised solvers (default 0)\n"
+  "  --ascii              write PLY as ascii instead of binary\n"
+  "  --json               print one JSON object with the report on stdout\n"
+  "  --quiet              print nothing on stderr but errors\n"
+  "  --help               print this text\n";
+
+template <typename T>
+T parse_number(const std::string& option, const std::string& text)
+{
+  std::istringstream in(text);
+  T value;
+  if (!(in >> value) || !in.eof())
+    throw Usage_error("invalid value '" + text + "' for " + option);
+  return value;
+}
+
+Options parse_options(int argc, char** argv)
+{
+  Options o;
+  std::vector<std::string> positional;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    auto value = [&]() -> std::string {
+      if (i + 1 >= argc)
+        throw Usage_error("option " + a + " needs a value");
+      return argv[++i];
+    };
+    if (a == "--help" || a == "-h") {
+      std::cout << usage_text;
+      std::exit(0);
+    } else if (a == "--k") {
+      const long k = parse_number<long>(a, value());
+      if (k < 1 || k > 1000)
+        throw Usage_error("--k must be between 1 and 1000");
+      o.k = unsigned(k);
+    } else if (a == "--radius") {
+      o.radius = parse_number<double>(a, value());
+      if (!(o.radius > 0.0) || !std::isfinite(o.radius))
+        throw Usage_error("--radius must be a number > 0");
+    } else if (a == "--criterion") {
+      o.criterion = value();
+      if (o.criterion != "hoppe" && o.criterion != "xie" && o.criterion != "konig")
+        throw Usage_error("unknown criterion '" + o.criterion + "' (hoppe, xie, konig)");
+    } else if (a == "--solver") {
+      o.solver = value();
+      if (o.solver != "mst")
+        throw Usage_error("unknown solver '" + o.solver + "' (mst)");
+    } else if (a == "--sign") {
+      o.sign = value();
+      if (o.sign != "outward" && o.sign != "keep")
+        throw Usage_error("unknown sign policy '" + o.sign + "' (outward, keep)");
+    } else if (a == "--viewpoint") {
+      std::string v = value();
+      for (char& c : v)
+        if (c == ',')
+          c = ' ';
+      std::istringstream in(v);
+      if (!(in >> o.viewpoint[0] >> o.viewpoint[1] >> o.viewpoint[2]) || !(in >> std::ws).eof() ||
+          !std::isfinite(o.viewpoint[0] + o.viewpoint[1] + o.viewpoint[2]))
+        throw Usage_error("--viewpoint needs X,Y,Z");
+      o.has_viewpoint = true;
+    } else if (a == "--normals") {
+      o.normals = value();
+      if (o.normals != "jet" && o.normals != "pca")
+        throw Usage_error("unknown normal estimator '" + o.normals + "' (jet, pca)");
+    } else if (a == "--normal-k") {
+      const long k = parse_number<long>(a, value());
+      if (k < 3 || k > 1000)
+        throw Usage_error("--normal-k must be between 3 and 1000");
+      o.normal_k = unsigned(k);
+    } else if (a == "--threads") {
+      const long t = parse_number<long>(a, value());
+      if (t < 1 || t > 1024)
+        throw Usage_error("--threads must be between 1 and 1024");
+      o.threads = int(t);
+    } else if (a == "--seed") {
+      o.seed = parse_number<unsigned long>(a, value());
+    } else if (a == "--json") {
+      o.json = true;
+    } else if (a == "--quiet" || a == "-q") {
+      o.quiet = true;
+    } else if (a == "--ascii") {
+      o.ascii = true;
+    } else if (a.size() > 1 && a[0] == '-') {
+      throw Usage_error("unknown option " + a);
+    } else {
+      positional.push_back(a);
+    }
+  }
+  if (positional.size() > 2)
+    throw Usage_error("too many arguments");
+  if (positional.empty()) {
+    o.input = NORMAL_ORIENTATION_SAMPLE_CLOUD;
+    o.output = "sample_oriented.ply";
+  } else {
+    o.input = positional[0];
+    if (positional.size() == 2) {
+      o.output = positional[1];
+    } else {
+      const std::size_t slash = o.input.find_last_of('/');
+      const std::size_t dot = o.input.find_last_of('.');
+      const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+      o.output = has_ext ? o.input.substr(0, dot) + "_oriented" + o.input.substr(dot)
+                         : o.input + "_oriented.ply";
+    }
+  }
+  return o;
+}
+
+/// A progress bar on stderr, drawn only when stderr is a terminal and the
+/// run lasts long enough to need one.
+class Progress_bar
+{
+public:
+  explicit Progress_bar(bool enabled)
+    : m_enabled(enabled && isatty(2)), m_start(std::chrono::steady_clock::now())
+  {}
+  bool operator()(double x)
+  {
+    if (!m_enabled)
+      return true;
+    const int percent = int(x * 100.0);
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - m_start).count();
+    if (percent == m_last || elapsed < 0.5)
+      return true;
+    m_last = percent;
+    const int width = 40, filled = percent * width / 100;
+    std::fprintf(stderr, "\r[%s%s] %3d%%", std::string(std::size_t(filled), '#').c_str(),
+                 std::string(std::size_t(width - filled), ' ').c_str(), percent);
+    m_drawn = true;
+    return true;
+  }
+  void finish()
+  {
+    if (m_drawn)
+      std::fprintf(stderr, "\r%60s\r", "");
+    m_drawn = false;
+  }
+
+private:
+  bool m_enabled;
+  std::chrono::steady_clock::time_point m_start;
+  int m_last = -1;
+  bool m_drawn = false;
+};
+
+std::string json_escape(const std::string& s)
+{
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\')
+      out += '\\';
+    if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      out += buf;
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+template <typename Criterion, typename Sign, typename Range, typename Np>
+NO::Orientation_result run(Range& range, const Np& np, const Criterion& criterion, const Sign& sign)
+{
+  return NO::orient_normals(range, np.flip_criterion(criterion).component_sign(sign));
+}
+
+template <typename Range, typename Np>
+NO::Orientation_result run_with_criterion(Range& range, const Np& np, const Options& o)
+{
+  auto with_sign = [&](const auto& criterion) {
+    if (o.has_viewpoint)
+      return run(range, np, criterion, NO::Viewpoint_component_sign(o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]));
+    if (o.sign == "keep")
+      return run(range, np, criterion, NO::Keep_component_sign());
+    return run(range, np, criterion, NO::Outward_component_sign());
+  };
+  if (o.criterion == "xie")
+    return with_sign(NO::Xie_criterion());
+  if (o.criterion == "konig")
+    return with_sign(NO::Konig_criterion());
+  return with_sign(NO::Hoppe_criterion());
+}
+
+int main_impl(int argc, char** argv)
+{
+  const auto t0 = std::chrono::steady_clock::now();
+  const Options o = parse_options(argc, argv);
+  auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
+
+  NO::IO::Point_cloud cloud = NO::IO::read_point_cloud(o.input);
+  const double read_seconds = since(t0);
+  if (cloud.size() == 0)
+    throw std::runtime_error(o.input + ": the file holds no point");
+
+  // The program's own structure, seen through index-based property maps.
+  std::vector<std::size_t> range(cloud.size());
+  std::iota(range.begin(), range.end(), std::size_t(0));
+  const Cloud_point_map point_map{&cloud};
+  const Cloud_normal_map normal_map{&cloud};
+
+  // Normal estimation, when the file has none.
+  double estimate_seconds = 0.0;
+  bool estimated = false;
+  if (!cloud.has_normals()) {
+    const auto t = std::chrono::steady_clock::now();
+    if (cloud.size() < 4)
+      throw std::runtime_error(o.input + ": too few points to estimate normals");
+    cloud.normals.assign(cloud.size(), {0.0, 0.0, 0.0});
+    const unsigned nk = unsigned(std::min<std::size_t>(o.normal_k, cloud.size() - 1));
+    auto np = CGAL::parameters::point_map(point_map).normal_map(normal_map);
+    if (o.normals == "pca")
+      CGAL::pca_estimate_normals<CGAL::Parallel_if_available_tag>(range, nk, np);
+    else
+      CGAL::jet_estimate_normals<CGAL::Parallel_if_available_tag>(range, nk, np);
+    estimate_seconds = since(t);
+    estimated = true;
+  }
+
+  Progress_bar bar(!o.quiet);
+  std::function<bool(double)> callback = [&bar](double x) { return bar(x); };
+  auto np = NO::parameters::point_map(point_map)
+              .normal_map(normal_map)
+              .number_of_neighbors(o.k)
+              .neighbor_radius(o.radius)
+              .number_of_threads(o.threads)
+              .random_seed(o.seed)
+              .callback(callback);
+  const NO::Orientation_result r = run_with_criterion(range, np, o);
+  bar.finish();
+
+  const auto tw = std::chrono::steady_clock::now();
+  NO::IO::Write_options wo;
+  wo.binary = !o.ascii;
+  NO::IO::write_point_cloud(o.output, cloud, wo);
+  const double write_seconds = since(tw);
+  const double total_seconds = since(t0);
+
+  if (!o.quiet) {
+    std::fprintf(stderr,
+                 "oriented %zu points%s: %zu edges (k = %u, r = %.6g), %zu component%s, energy %.6g -> %.6g, "
+                 "%zu normals flipped, %.3f s\n",
+                 r.number_of_points, estimated ? " (normals estimated)" : "", r.number_of_edges,
+                 r.number_of_neighbors, r.neighbor_radius, r.number_of_components,
+                 r.number_of_components == 1 ? "" : "s", r.energy_before, r.energy_after, r.number_of_flipped,
+                 total_seconds);
+    std::fprintf(stderr, "wrote %s\n", o.output.c_str());
+  }
+  if (o.json) {
+    std::printf("{\"input\": \"%s\", \"output\": \"%s\", \"points\": %zu, \"edges\": %zu, \"components\": %zu, "
+                "\"k\": %u, \"radius\": %.9g, \"radius_estimated\": %s, \"criterion\": \"%s\", \"solver\": \"%s\", "
+                "\"component_sign\": \"%s\", \"seed\": %lu, \"threads\": %d, \"normals_estimated\": %s, "
+                "\"energy_before\": %.9g, \"energy_after\": %.9g, \"frustrated_edges\": %zu, \"flipped\": %zu, "
+                "\"zero_normals\": %zu, \"seconds\": {\"read\": %.6f, \"estimate_normals\": %.6f, "
+                "\"neighbors\": %.6f, \"graph\": %.6f, \"solve\": %.6f, \"sign\": %.6f, \"orient_total\": %.6f, "
+                "\"write\": %.6f, \"total\": %.6f}}\n",
+                json_escape(o.input).c_str(), json_escape(o.output).c_str(), r.number_of_points, r.number_of_edges,
+                r.number_of_components, r.number_of_neighbors, r.neighbor_radius,
+                r.radius_estimated ? "true" : "false", r.criterion.c_str(), r.solver.c_str(),
+                r.component_sign.c_str(), o.seed, o.threads, estimated ? "true" : "false", r.energy_before,
+                r.energy_after, r.frustrated_edges, r.number_of_flipped, r.number_of_zero_normals, read_seconds,
+                estimate_seconds, r.seconds.neighbors, r.seconds.graph, r.seconds.solve, r.seconds.sign,
+                r.seconds.total, write_seconds, total_seconds);
+  }
+  return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+  try {
+    return main_impl(argc, argv);
+  } catch (const Usage_error& e) {
+    std::fprintf(stderr, "orient_normals: %s (see --help)\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "orient_normals: error: %s\n", e.what());
+    return 1;
+  }
+}

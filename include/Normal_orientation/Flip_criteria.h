@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_FLIP_CRITERIA_H
+#define NORMAL_ORIENTATION_FLIP_CRITERIA_H
+
+/// \file Flip_criteria.h
+/// Flip criteria: models of the `FlipCriterion` concept.
+///
+/// A flip criterion maps an edge (p_i, n_i), (p_j, n_j) of the neighbour graph
+/// to phi in [-1, 1]: phi > 0 when the two normals are consistently oriented,
+/// phi < 0 when one of them should flip, |phi| the certainty (paper, sec. 3).
+/// Every model here is symmetric in i and j, invariant when both normals
+/// flip, accepts normals of any length (they are normalised internally) and
+/// returns a finite value on degenerate input: phi = 0 when a normal is zero,
+/// that is "nothing can be said".
+
+#include <Normal_orientation/internal/Konig_curves.h>
+
+#include <CGAL/number_utils.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace Normal_orientation {
+
+/// \cond SKIP_IN_MANUAL
+namespace internal {
+
+/// a plain 3-vector of doubles, used by the criteria
+struct Vec3
+{
+  double x, y, z;
+};
+
+template <typename P>
+Vec3 to_vec3(const P& p)
+{
+  return Vec3{CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())};
+}
+
+inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+/// normalises `v` in place; returns false (and leaves a zero vector) when
+/// `v` is zero or not finite
+inline bool normalize(Vec3& v)
+{
+  const double l2 = dot(v, v);
+  if (!(l2 > 0.0) || !std::isfinite(l2)) {
+    v = Vec3{0.0, 0.0, 0.0};
+    return false;
+  }
+  const double inv = 1.0 / std::sqrt(l2);
+  v.x *= inv; v.y *= inv; v.z *= inv;
+  return true;
+}
+
+inline double clamp_unit(double x) { return std::min(1.0, std::max(-1.0, x)); }
+
+} // namespace internal
+/// \endcond
+
+/// \ingroup PkgNormalOrientationCriteria
+/// Hoppe's criterion (paper eq. 1): phi = <n_i, n_j> for unit normals.
+/// Best on smooth, densely sampled surfaces and the most robust to noise;
+/// fails at sharp creases and across thin parts, where the true normals of
+/// neighbours point in different or opposite directions.
+/// \cgalModels `FlipCriterion`
+struct Hoppe_criterion
+{
+  /// returns phi in [-1, 1] for the edge (p_i, n_i)-(p_j, n_j)
+  template <typename Point, typename Vector>
+  double operator()(const Point&, const Vector& n_i, const Point&, const Vector& n_j) const
+  {
+    internal::Vec3 a = internal::to_vec3(n_i), b = internal::to_vec3(n_j);
+    if (!internal::normalize(a) || !internal::normalize(b))
+      return 0.0;
+    return internal::clamp_unit(internal::dot(a, b));
+  }
+  /// the name used on the command line and in reports
+  static const char* name() { return "hoppe"; }
+};
+
+/// \ingroup PkgNormalOrientationCriteria
+/// Xie's criterion (supplement eq. 1): n_i is reflected on the plane
+/// orthogonal to e = (p_i - p_j) / |p_i - p_j| and compared with n_j:
+/// phi = <n_i - 2 e <e, n_i>, n_j> = <n_i, n_j> - 2 <e, n_i><e, n_j>.
+/// It orients sharp creases and close parallel sheets (thin parts) where
+/// Hoppe's criterion fails.  For coincident points e is undefined and the
+/// criterion falls back to Hoppe's.
+/// \cgalModels `FlipCriterion`
+struct Xie_criterion
+{
+  /// returns phi in [-1, 1] for the edge (p_i, n_i)-(p_j, n_j)
+  template <typename Point, typename Vector>
+  double operator()(const Point& p_i, const Vector& n_i, const Point& p_j, const Vector& n_j) const
+  {
+    internal::Vec3 a = internal::to_vec3(n_i), b = internal::to_vec3(n_j);
+    if (!internal::normalize(a) || !internal::normalize(b))
+      return 0.0;
+    const internal::Vec3 pi = internal::to_vec3(p_i), pj = internal::to_vec3(p_j);
+    internal::Vec3 e{pi.x - pj.x, pi.y - pj.y, pi.z - pj.z};
+    if (!internal::normalize(e))
+      return internal::clamp_unit(internal::dot(a, b));
+    return internal::clamp_unit(internal::dot(a, b) - 2.0 * internal::dot(e, a) * internal::dot(e, b));
+  }
+  /// the name used on the command line and in reports
+  static const char* name() { return "xie"; }
+};
+
+/// \ingroup PkgNormalOrientationCriteria
+/// König and Gumhold's criterion (VMV 2009): the two points are joined by
+/// cubic Hermite curves whose end tangents are perpendicular to the normals,
+/// once with the normals as given ("keep") and once with one of them flipped
+/// ("flip"); the curve that turns less wins.  phi = sign(c_flip - c_keep) *
+/// (1 - min(c_keep, c_flip) / max(c_keep, c_flip)), where c is the total
+/// turning angle of the best curve of each kind.  It assumes low curvature
+/// between neighbours and handles creases better than Hoppe's criterion.
+/// \cgalModels `FlipCriterion`
+struct Konig_criterion
+{
+  /// returns phi in [-1, 1] for the edge (p_i, n_i)-(p_j, n_j)
+  template <typename Point, typename Vector>
+  double operator()(const Point& p_i, const Vector& n_i, const Point& p_j, const Vector& n_j) const
+  {
+    const internal::Vec3 pi = internal::to_vec3(p_i), pj = internal::to_vec3(p_j);
+    const internal::Vec3 ni = internal::to_vec3(n_i), nj = internal::to_vec3(n_j);
+    const double a[3] = {pi.x, pi.y, pi.z}, b[3] = {pj.x, pj.y, pj.z};
+    const double na[3] = {ni.x, ni.y, ni.z}, nb[3] = {nj.x, nj.y, nj.z};
+    return internal::clamp_unit(internal::konig_phi(a, na, b, nb));
+  }
+  /// the name used on the command line and in reports
+  static const char* name() { return "konig"; }
+};
+
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_FLIP_CRITERIA_H

@@ -1,0 +1,360 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_NEIGHBOR_GRAPH_H
+#define NORMAL_ORIENTATION_NEIGHBOR_GRAPH_H
+
+/// \file Neighbor_graph.h
+/// The symmetric, radius-truncated k-nearest-neighbour graph of the paper
+/// (sec. 3), with the edge weights w_ij = phi(i, j) * omega(p_i, p_j).
+
+#include <Normal_orientation/internal/Progress.h>
+
+#include <CGAL/Kd_tree.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
+#include <CGAL/Search_traits_3.h>
+#include <CGAL/Search_traits_adapter.h>
+#include <CGAL/Splitters.h>
+#include <CGAL/property_map.h>
+#include <CGAL/tags.h>
+
+#include <boost/graph/compressed_sparse_row_graph.hpp>
+#include <boost/iterator/counting_iterator.hpp>
+
+#ifdef CGAL_LINKED_WITH_TBB
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#endif
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace Normal_orientation {
+
+/// \ingroup PkgNormalOrientationGraph
+/// The bundled property of an edge of the neighbour graph.
+struct Neighbor_edge
+{
+  /// the signed weight w_ij = phi(i, j) * omega(p_i, p_j)
+  float weight = 0.f;
+};
+
+/// \ingroup PkgNormalOrientationGraph
+/// The neighbour graph: a Boost compressed-sparse-row graph with 32-bit
+/// vertex and edge indices.  Each undirected neighbour pair {i, j} is stored
+/// once, as one arc whose direction means nothing (see
+/// `Orientation_problem.h`).  Read the weights with
+/// `get(&Neighbor_edge::weight, graph)`.
+typedef boost::compressed_sparse_row_graph<boost::directedS, boost::no_property, Neighbor_edge,
+                                           boost::no_property, std::uint32_t, std::uint32_t>
+  Neighbor_graph;
+
+/// \ingroup PkgNormalOrientationGraph
+/// What the graph construction measured and decided.
+struct Neighbor_graph_report
+{
+  /// the number of neighbours k actually used (k is lowered to n - 1 for
+  /// clouds of at most k points)
+  unsigned int number_of_neighbors = 0;
+  /// the radius r actually used (given or estimated)
+  double radius = 0.0;
+  /// true when r was estimated from the data
+  bool radius_estimated = false;
+  /// the median distance from a point to its k-th nearest neighbour
+  double median_kth_distance = 0.0;
+  /// the number of (undirected) edges
+  std::size_t number_of_edges = 0;
+  /// seconds spent in the kd-tree and the kNN queries
+  double seconds_neighbors = 0.0;
+  /// seconds spent in the weights and the graph assembly
+  double seconds_graph = 0.0;
+};
+
+/// \ingroup PkgNormalOrientationGraph
+/// The rule used when no radius is given: r = `default_radius_factor` times
+/// the 90th percentile, over all points, of the distance from a point to its
+/// k-th nearest neighbour.  A percentile of the k-th neighbour distance
+/// follows the sampling density, so the rule works at any scale; taking a
+/// high percentile and a factor above 1 keeps sparsely sampled regions
+/// connected on clouds of uneven density, while omega = 1 - d^2 / r^2 still
+/// favours the closest neighbours.  Outliers farther than r from everything
+/// become isolated points.
+constexpr double default_radius_factor = 2.0;
+/// the percentile of the k-th neighbour distance used by the radius rule
+constexpr double default_radius_percentile = 0.9;
+
+/// \cond SKIP_IN_MANUAL
+namespace internal {
+
+/// Runs `f(begin, end)` over [0, n) in chunks, in parallel when
+/// `ConcurrencyTag` is `CGAL::Parallel_tag` and TBB is linked.
+template <typename ConcurrencyTag, typename F>
+void parallel_chunks(std::size_t n, const F& f, std::size_t grain = 1024)
+{
+#ifdef CGAL_LINKED_WITH_TBB
+  if (std::is_convertible<ConcurrencyTag, CGAL::Parallel_tag>::value) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain),
+                      [&](const tbb::blocked_range<std::size_t>& r) { f(r.begin(), r.end()); });
+    return;
+  }
+#endif
+  (void)grain;
+  f(std::size_t(0), n);
+}
+
+/// Sorts `v` with `less` (in parallel with TBB); the result is the same for
+/// any thread count when `less` is a strict total order.
+template <typename ConcurrencyTag, typename T, typename Less>
+void parallel_sort(std::vector<T>& v, Less less)
+{
+#ifdef CGAL_LINKED_WITH_TBB
+  if (std::is_convertible<ConcurrencyTag, CGAL::Parallel_tag>::value) {
+    tbb::parallel_sort(v.begin(), v.end(), less);
+    return;
+  }
+#endif
+  std::sort(v.begin(), v.end(), less);
+}
+
+/// spreads the low 21 bits of x to every third bit
+inline std::uint64_t spread_bits_3(std::uint64_t x)
+{
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+/// Returns the indices 0..n-1 in Morton (Z-curve) order of the points, ties
+/// broken by index: queries made in this order hit the kd-tree's caches.
+template <typename ConcurrencyTag, typename Point>
+std::vector<std::uint32_t> morton_order(const std::vector<Point>& points)
+{
+  const std::size_t n = points.size();
+  double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                  std::numeric_limits<double>::max()};
+  double hi[3] = {-lo[0], -lo[1], -lo[2]};
+  for (const Point& p : points)
+    for (int d = 0; d < 3; ++d) {
+      const double c = CGAL::to_double(p[d]);
+      lo[d] = std::min(lo[d], c);
+      hi[d] = std::max(hi[d], c);
+    }
+  double extent = 0.0;
+  for (int d = 0; d < 3; ++d)
+    extent = std::max(extent, hi[d] - lo[d]);
+  const double scale = extent > 0.0 ? double((1u << 21) - 1) / extent : 0.0;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
+  parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      std::uint64_t code = 0;
+      for (int d = 0; d < 3; ++d)
+        code |= spread_bits_3(std::uint64_t((CGAL::to_double(points[i][d]) - lo[d]) * scale)) << d;
+      keyed[i] = {code, std::uint32_t(i)};
+    }
+  });
+  parallel_sort<ConcurrencyTag>(keyed, std::less<std::pair<std::uint64_t, std::uint32_t>>());
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t i = 0; i < n; ++i)
+    order[i] = keyed[i].second;
+  return order;
+}
+
+/// The k nearest neighbours of every point (itself excluded), as flat
+/// arrays: neighbors[i*k + t] and squared distances sq_dist[i*k + t],
+/// t = 0..k-1, sorted by distance.  Computed with CGAL's kd-tree and
+/// `Orthogonal_k_neighbor_search`, queries in parallel.
+template <typename ConcurrencyTag, typename Kernel>
+void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, unsigned int k,
+                         std::vector<std::uint32_t>& neighbors, std::vector<float>& sq_dist,
+                         const Progress& progress, double progress_begin, double progress_end)
+{
+  typedef typename Kernel::Point_3 Point;
+  typedef CGAL::Search_traits_3<Kernel> Base_traits;
+  typedef CGAL::Pointer_property_map<Point> Pmap_factory;
+  typedef typename Pmap_factory::const_type Point_pmap;
+  typedef CGAL::Search_traits_adapter<std::uint32_t, Point_pmap, Base_traits> Traits;
+  typedef CGAL::Sliding_midpoint<Traits> Splitter;
+  typedef CGAL::Distance_adapter<std::uint32_t, Point_pmap, CGAL::Euclidean_distance<Base_traits>> Distance;
+  typedef CGAL::Kd_tree<Traits, Splitter, CGAL::Tag_true, CGAL::Tag_true> Tree;
+  typedef CGAL::Orthogonal_k_neighbor_search<Traits, Distance, Splitter, Tree> Search;
+
+  const std::size_t n = points.size();
+  neighbors.assign(n * k, 0);
+  sq_dist.assign(n * k, 0.f);
+  if (n == 0 || k == 0)
+    return;
+  const Point_pmap pmap = CGAL::make_property_map(points);
+  Tree tree(boost::counting_iterator<std::uint32_t>(0), boost::counting_iterator<std::uint32_t>(std::uint32_t(n)),
+            Splitter(), Traits(pmap));
+  tree.template build<ConcurrencyTag>();
+  const Distance distance(pmap);
+  const std::vector<std::uint32_t> order = morton_order<ConcurrencyTag>(points);
+
+  // Queries in blocks so that progress is reported (and interruption
+  // checked) on the calling thread between blocks.
+  const std::size_t block = std::size_t(1) << 16;
+  for (std::size_t b0 = 0; b0 < n; b0 += block) {
+    const std::size_t b1 = std::min(n, b0 + block);
+    parallel_chunks<ConcurrencyTag>(b1 - b0, [&](std::size_t cb, std::size_t ce) {
+      for (std::size_t q = b0 + cb; q < b0 + ce; ++q) {
+        const std::uint32_t i = order[q];
+        Search search(tree, points[i], k + 1, 0, true, distance, true);
+        std::uint32_t* out = &neighbors[std::size_t(i) * k];
+        float* out_d = &sq_dist[std::size_t(i) * k];
+        unsigned int t = 0;
+        bool self_skipped = false;
+        for (auto it = search.begin(); it != search.end() && t < k; ++it) {
+          if (!self_skipped && it->first == i) {
+            self_skipped = true;
+            continue;
+          }
+          out[t] = it->first;
+          out_d[t] = float(CGAL::to_double(it->second));
+          ++t;
+        }
+        // with fewer than k + 1 points nothing is missing: k <= n - 1
+      }
+    }, 256);
+    progress.report(progress_begin + (progress_end - progress_begin) * double(b1) / double(n));
+  }
+}
+
+} // namespace internal
+/// \endcond
+
+/// \ingroup PkgNormalOrientationGraph
+/// Builds the neighbour graph of the paper (sec. 3): i and j are joined iff
+/// one is among the other's `k` nearest neighbours and |p_i - p_j| < r; the
+/// edge weight is w_ij = phi(i, j) * (1 - |p_i - p_j|^2 / r^2).
+///
+/// \tparam ConcurrencyTag `CGAL::Parallel_tag` (kd-tree build, queries and
+///         weights in parallel with TBB) or `CGAL::Sequential_tag`; the
+///         graph is identical either way.
+/// \param points the positions
+/// \param normals the normals, same size (any length; zero allowed)
+/// \param k the number of neighbours, >= 1 (lowered to n - 1 when n <= k)
+/// \param radius r > 0, or 0 to estimate it (see `default_radius_factor`)
+/// \param criterion a model of `FlipCriterion`
+/// \param graph receives the graph
+/// \param progress receives progress in [0, 1] and may interrupt the run
+/// \pre points and normals are finite (checked by `orient_normals()`)
+template <typename ConcurrencyTag, typename Kernel, typename FlipCriterion>
+Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Point_3>& points,
+                                           const std::vector<typename Kernel::Vector_3>& normals,
+                                           unsigned int k, double radius, const FlipCriterion& criterion,
+                                           Neighbor_graph& graph, const internal::Progress& progress)
+{
+  if (points.size() != normals.size())
+    throw std::invalid_argument("build_neighbor_graph: points and normals differ in size");
+  if (k < 1)
+    throw std::invalid_argument("build_neighbor_graph: the number of neighbors must be at least 1");
+  if (!(radius >= 0.0) || !std::isfinite(radius))
+    throw std::invalid_argument("build_neighbor_graph: the radius must be a finite number > 0");
+  if (points.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max()))
+    throw std::length_error("build_neighbor_graph: more than 2^32 - 1 points");
+
+  Neighbor_graph_report report;
+  const std::size_t n = points.size();
+  k = unsigned(std::min<std::size_t>(k, n > 0 ? n - 1 : 0));
+  report.number_of_neighbors = k;
+  auto t0 = std::chrono::steady_clock::now();
+
+  std::vector<std::uint32_t> nb;
+  std::vector<float> d2;
+  internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(points, k, nb, d2, progress, 0.0, 0.8);
+  auto t1 = std::chrono::steady_clock::now();
+  report.seconds_neighbors = std::chrono::duration<double>(t1 - t0).count();
+
+  // Radius.
+  if (k > 0) {
+    std::vector<float> kth(n);
+    for (std::size_t i = 0; i < n; ++i)
+      kth[i] = d2[i * k + (k - 1)];
+    auto mid = kth.begin() + std::ptrdiff_t(n / 2);
+    std::nth_element(kth.begin(), mid, kth.end());
+    report.median_kth_distance = std::sqrt(double(*mid));
+    if (radius == 0.0) {
+      auto q = kth.begin() + std::ptrdiff_t(std::min(n - 1, std::size_t(default_radius_percentile * double(n))));
+      std::nth_element(kth.begin(), q, kth.end());
+      radius = default_radius_factor * std::sqrt(double(*q));
+      report.radius_estimated = true;
+      if (!(radius > 0.0)) // every point has k coincident neighbours
+        radius = 1.0;
+    }
+  } else if (radius == 0.0) {
+    radius = 1.0;
+    report.radius_estimated = true;
+  }
+  report.radius = radius;
+  const double r2 = radius * radius;
+
+  // Each undirected edge {i, j} is emitted once: by i if j is one of i's
+  // neighbours and (i < j or i is not one of j's neighbours).
+  auto keeps = [&](std::size_t i, unsigned t) -> bool {
+    if (!(double(d2[i * k + t]) < r2))
+      return false;
+    const std::uint32_t j = nb[i * k + t];
+    if (j == i)
+      return false;
+    if (i < j)
+      return true;
+    const std::uint32_t* nj = &nb[std::size_t(j) * k];
+    for (unsigned s = 0; s < k; ++s)
+      if (nj[s] == i && double(d2[std::size_t(j) * k + s]) < r2)
+        return false;
+    return true;
+  };
+  std::vector<std::uint32_t> count(n + 1, 0);
+  internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      std::uint32_t c = 0;
+      for (unsigned t = 0; t < k; ++t)
+        c += keeps(i, t) ? 1 : 0;
+      count[i + 1] = c;
+    }
+  });
+  for (std::size_t i = 0; i < n; ++i)
+    count[i + 1] += count[i];
+  const std::size_t m = count[n];
+  std::vector<std::uint32_t> sources(m), targets(m);
+  std::vector<Neighbor_edge> props(m);
+  internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      std::size_t pos = count[i];
+      for (unsigned t = 0; t < k; ++t) {
+        if (!keeps(i, t))
+          continue;
+        const std::uint32_t j = nb[i * k + t];
+        const double omega = 1.0 - double(d2[i * k + t]) / r2;
+        sources[pos] = std::uint32_t(i);
+        targets[pos] = j;
+        props[pos].weight = float(criterion(points[i], normals[i], points[j], normals[j]) * omega);
+        ++pos;
+      }
+    }
+  });
+  progress.report(0.9);
+  { std::vector<std::uint32_t>().swap(nb); std::vector<float>().swap(d2); }
+  Neighbor_graph g(boost::construct_inplace_from_sources_and_targets, sources, targets, props,
+                   std::uint32_t(n));
+  std::swap(graph, g);
+  report.number_of_edges = m;
+  report.seconds_graph = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  progress.report(1.0);
+  return report;
+}
+
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_NEIGHBOR_GRAPH_H

@@ -1,0 +1,95 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_ORIENTATION_PROBLEM_H
+#define NORMAL_ORIENTATION_ORIENTATION_PROBLEM_H
+
+/// \file Orientation_problem.h
+/// The orientation energy (paper eq. 2-3) and the connected components of
+/// an orientation problem, for any Boost graph with a signed edge weight map.
+///
+/// Conventions shared by every function and solver of the package:
+/// - every edge `e` of the graph is one pairwise term of the energy between
+///   `source(e, g)` and `target(e, g)`; its direction, if the graph is
+///   directed, is ignored, so store each neighbour pair once;
+/// - the weight w_e = phi * omega is signed: w > 0 asks for equal labels,
+///   w < 0 for different labels, |w| is the penalty when the wish is not met;
+/// - labels are +1 (keep the normal) or -1 (flip it).
+
+#include <Normal_orientation/Signed_union_find.h>
+
+#include <boost/graph/graph_traits.hpp>
+#include <boost/graph/properties.hpp>
+#include <boost/property_map/property_map.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace Normal_orientation {
+
+/// \ingroup PkgNormalOrientationProblem
+/// The type of a label: +1 keeps a normal, -1 flips it.
+typedef signed char Label;
+
+/// \ingroup PkgNormalOrientationProblem
+/// The penalty of one edge of weight `w` whose end labels are `l_i`, `l_j`
+/// (paper eq. 2): |w| when (w >= 0) xor (l_i == l_j), else 0.
+inline double edge_energy(double w, int l_i, int l_j)
+{
+  const bool same = (l_i == l_j);
+  if (w >= 0.0)
+    return same ? 0.0 : w;
+  return same ? -w : 0.0;
+}
+
+/// \ingroup PkgNormalOrientationProblem
+/// Returns the energy E(L) of eq. 3 of the labelling `labels` (a readable
+/// vertex property map with values +1/-1) on `g` with the signed edge
+/// weights `weight` (a readable edge property map).
+/// \tparam Graph a model of `EdgeListGraph`
+template <typename Graph, typename WeightMap, typename LabelMap>
+double energy(const Graph& g, WeightMap weight, LabelMap labels)
+{
+  double e = 0.0;
+  typename boost::graph_traits<Graph>::edge_iterator it, end;
+  for (boost::tie(it, end) = edges(g); it != end; ++it)
+    e += edge_energy(double(get(weight, *it)),
+                     int(get(labels, source(*it, g))),
+                     int(get(labels, target(*it, g))));
+  return e;
+}
+
+/// \ingroup PkgNormalOrientationProblem
+/// Numbers the connected components of the graph formed by the edges of
+/// non-zero weight (an edge of weight zero carries no information, so it
+/// does not join its ends).  Components are numbered 0, 1, ... in the order
+/// of their smallest vertex index; `component[i]` receives the number of
+/// vertex `i`.  Returns the number of components.
+/// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
+///         internal `vertex_index` map
+template <typename Graph, typename WeightMap>
+std::size_t connected_components(const Graph& g, WeightMap weight, std::vector<std::uint32_t>& component)
+{
+  const std::size_t n = num_vertices(g);
+  auto index = get(boost::vertex_index, g);
+  Signed_union_find uf(n);
+  typename boost::graph_traits<Graph>::edge_iterator it, end;
+  for (boost::tie(it, end) = edges(g); it != end; ++it)
+    if (double(get(weight, *it)) != 0.0)
+      uf.unite(Signed_union_find::Index(get(index, source(*it, g))),
+               Signed_union_find::Index(get(index, target(*it, g))));
+  const std::uint32_t unset = ~std::uint32_t(0);
+  std::vector<std::uint32_t> root_id(n, unset);
+  component.assign(n, 0);
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto r = uf.find(Signed_union_find::Index(i));
+    if (root_id[r] == unset)
+      root_id[r] = std::uint32_t(count++);
+    component[i] = root_id[r];
+  }
+  return count;
+}
+
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_ORIENTATION_PROBLEM_H

@@ -1,0 +1,349 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_ORIENT_NORMALS_H
+#define NORMAL_ORIENTATION_ORIENT_NORMALS_H
+
+/// \file orient_normals.h
+/// The in-core entry point: `Normal_orientation::orient_normals()`.
+
+#include <Normal_orientation/Component_sign.h>
+#include <Normal_orientation/Flip_criteria.h>
+#include <Normal_orientation/Neighbor_graph.h>
+#include <Normal_orientation/Orientation_problem.h>
+#include <Normal_orientation/internal/Progress.h>
+#include <Normal_orientation/parameters.h>
+#include <Normal_orientation/solvers/Mst_solver.h>
+
+#include <CGAL/Kernel_traits.h>
+#include <CGAL/boost/graph/named_params_helper.h>
+#include <CGAL/property_map.h>
+#include <CGAL/tags.h>
+
+#ifdef CGAL_LINKED_WITH_TBB
+#include <tbb/task_arena.h>
+#endif
+
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <functional>
+#include <iterator>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+namespace Normal_orientation {
+
+/// \ingroup PkgNormalOrientationRef
+/// Wall-clock seconds of each stage of `orient_normals()`.
+struct Stage_seconds
+{
+  double input = 0.0;     ///< copying and checking the input
+  double neighbors = 0.0; ///< kd-tree and k-nearest-neighbour queries
+  double graph = 0.0;     ///< edge weights and graph assembly
+  double solve = 0.0;     ///< the solver
+  double sign = 0.0;      ///< components and their global signs
+  double output = 0.0;    ///< writing the normals back
+  double total = 0.0;     ///< the whole call
+};
+
+/// \ingroup PkgNormalOrientationRef
+/// What `orient_normals()` did.
+struct Orientation_result
+{
+  std::size_t number_of_points = 0;     ///< points in the input
+  std::size_t number_of_edges = 0;      ///< edges of the neighbour graph
+  std::size_t number_of_components = 0; ///< connected components (each got its own global sign)
+  std::size_t number_of_flipped = 0;    ///< normals whose sign was changed
+  std::size_t number_of_zero_normals = 0; ///< zero normals (left as they were)
+  unsigned int number_of_neighbors = 0; ///< k used
+  double neighbor_radius = 0.0;         ///< r used
+  bool radius_estimated = false;        ///< true when r was estimated from the data
+  double energy_before = 0.0;           ///< energy (eq. 3) of the input orientation
+  double energy_after = 0.0;            ///< energy of the output orientation
+  std::size_t frustrated_edges = 0;     ///< edges whose wish the output does not meet
+  std::string criterion;                ///< the flip criterion's name
+  std::string solver;                   ///< the solver's name
+  std::string component_sign;           ///< the component sign policy's name
+  bool interrupted = false;             ///< true when the callback stopped the run (nothing was written)
+  Stage_seconds seconds;                ///< time per stage
+};
+
+/// \cond SKIP_IN_MANUAL
+namespace internal {
+
+template <typename T, typename = void>
+struct Has_name : std::false_type {};
+template <typename T>
+struct Has_name<T, std::void_t<decltype(T::name())>> : std::true_type {};
+
+template <typename T>
+std::string name_of(const T&)
+{
+  if constexpr (Has_name<T>::value)
+    return T::name();
+  else
+    return "user";
+}
+
+inline double seconds_since(std::chrono::steady_clock::time_point t)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+/// runs `f` with at most `threads` threads (0: all)
+template <typename F>
+void run_with_threads(int threads, const F& f)
+{
+#ifdef CGAL_LINKED_WITH_TBB
+  if (threads > 0) {
+    tbb::task_arena arena(threads);
+    arena.execute(f);
+    return;
+  }
+#endif
+  (void)threads;
+  f();
+}
+
+} // namespace internal
+/// \endcond
+
+/// \ingroup PkgNormalOrientationRef
+/// Orients the normals of `points` consistently and, by default, outward.
+///
+/// The pipeline of the paper (Schertler et al. 2017, sec. 3-4): the
+/// symmetric, radius-truncated k-nearest-neighbour graph; edge weights
+/// w_ij = phi(i, j) * (1 - d_ij^2 / r^2) from a flip criterion; a solver
+/// minimising the energy of eq. 3 over the labels L_i in {+1, -1}; then a
+/// component sign policy fixes the free sign of every connected component;
+/// finally n_i <- L_i n_i through the normal map.
+///
+/// The input order is never changed and only the sign of normals changes
+/// (their length and direction are kept exactly).  Zero normals are left
+/// as they are.  When the callback interrupts the run, or an exception is
+/// thrown, no normal has been modified.
+///
+/// \tparam ConcurrencyTag `CGAL::Parallel_tag`, `CGAL::Sequential_tag` or
+///   `CGAL::Parallel_if_available_tag` (the default); results are the same
+///   for any choice and any number of threads.
+/// \tparam PointRange a model of `Range` whose iterator is a forward
+///   iterator; its value type is the key of the point and normal maps.
+///
+/// \param points the input points, with unoriented normals
+/// \param np optional named parameters among:
+/// \cgalNamedParamsBegin
+///   \cgalParamNBegin{point_map}
+///     \cgalParamDescription{a property map associating points to the elements of `points`}
+///     \cgalParamType{a model of `ReadablePropertyMap` with value type `geom_traits::Point_3`}
+///     \cgalParamDefault{`CGAL::Identity_property_map<geom_traits::Point_3>`}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{normal_map}
+///     \cgalParamDescription{a property map associating normals to the elements of `points`}
+///     \cgalParamType{a model of `ReadWritePropertyMap` with value type `geom_traits::Vector_3`}
+///     \cgalParamDefault{none: this parameter is required}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{geom_traits}
+///     \cgalParamDescription{the geometric traits}
+///     \cgalParamDefault{the kernel of the point type}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{number_of_neighbors}
+///     \cgalParamDescription{k of the k-nearest-neighbour graph (a `Normal_orientation::parameters` name)}
+///     \cgalParamType{unsigned int, at least 1}
+///     \cgalParamDefault{`10`}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{neighbor_radius}
+///     \cgalParamDescription{the radius r: no edge is longer, and omega = 1 - d^2 / r^2}
+///     \cgalParamType{floating scalar value > 0}
+///     \cgalParamDefault{estimated: `default_radius_factor` times a high percentile of the k-th neighbour distance}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{flip_criterion}
+///     \cgalParamDescription{a model of `FlipCriterion`}
+///     \cgalParamDefault{`Hoppe_criterion()`}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{solver}
+///     \cgalParamDescription{a model of `OrientationSolver`}
+///     \cgalParamDefault{`Mst_solver()`}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{component_sign}
+///     \cgalParamDescription{a model of `ComponentSignPolicy`}
+///     \cgalParamDefault{`Outward_component_sign()`, or `Constrained_component_sign<>()` when `point_is_constrained_map` is given}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{point_is_constrained_map}
+///     \cgalParamDescription{points whose input normal is known to be correctly oriented}
+///     \cgalParamType{a model of `ReadablePropertyMap` with value type `bool`}
+///     \cgalParamDefault{no constrained point}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{callback}
+///     \cgalParamDescription{called with the progress in [0, 1], from the calling thread; returning `false` interrupts the run}
+///     \cgalParamType{`std::function<bool(double)>`}
+///     \cgalParamDefault{none}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{random_seed}
+///     \cgalParamDescription{the seed of randomised solvers}
+///     \cgalParamType{unsigned int}
+///     \cgalParamDefault{`0`}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{number_of_threads}
+///     \cgalParamDescription{the maximum number of threads (a `Normal_orientation::parameters` name)}
+///     \cgalParamType{int, 0 for all}
+///     \cgalParamDefault{`0`}
+///   \cgalParamNEnd
+/// \cgalNamedParamsEnd
+///
+/// \return an `Orientation_result`
+/// \throw std::invalid_argument for k < 1, r <= 0, a negative thread
+///   count, or a non-finite coordinate or normal (the message names the point)
+template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag, typename PointRange,
+          typename NamedParameters = parameters::Default_named_parameters>
+Orientation_result orient_normals(PointRange& points, const NamedParameters& np = parameters::default_values())
+{
+  using CGAL::parameters::choose_parameter;
+  using CGAL::parameters::get_parameter;
+  typedef CGAL::Point_set_processing_3_np_helper<PointRange, NamedParameters> NP_helper;
+  typedef typename NP_helper::Point_map Point_map;
+  typedef typename NP_helper::Normal_map Normal_map;
+  typedef typename NP_helper::Geom_traits Kernel;
+  typedef typename Kernel::Point_3 Point;
+  typedef typename Kernel::Vector_3 Vector;
+  static_assert(NP_helper::has_normal_map(), "orient_normals: the normal_map named parameter is required");
+
+  const auto t_start = std::chrono::steady_clock::now();
+  const Point_map point_map = NP_helper::get_point_map(points, np);
+  const Normal_map normal_map = NP_helper::get_normal_map(points, np);
+  const unsigned int k = choose_parameter(get_parameter(np, internal_np::number_of_neighbors), 10u);
+  const double radius = double(choose_parameter(get_parameter(np, CGAL::internal_np::neighbor_radius), 0.0));
+  const int threads = int(choose_parameter(get_parameter(np, internal_np::number_of_threads), 0));
+  const auto criterion = choose_parameter(get_parameter(np, internal_np::flip_criterion), Hoppe_criterion());
+  const auto solver = choose_parameter(get_parameter(np, internal_np::solver), Mst_solver());
+  const std::function<bool(double)> callback =
+    choose_parameter(get_parameter(np, CGAL::internal_np::callback), std::function<bool(double)>());
+  constexpr bool has_constraints =
+    !CGAL::parameters::is_default_parameter<NamedParameters, CGAL::internal_np::point_is_constrained_t>::value;
+  typedef std::conditional_t<has_constraints, Constrained_component_sign<>, Outward_component_sign> Default_sign;
+  const auto sign_policy = choose_parameter(get_parameter(np, internal_np::component_sign), Default_sign());
+
+  if (k < 1 || k > 100000)
+    throw std::invalid_argument("orient_normals: number_of_neighbors must be between 1 and 100000");
+  if (radius != 0.0 && !(radius > 0.0 && std::isfinite(radius)))
+    throw std::invalid_argument("orient_normals: neighbor_radius must be a finite number > 0");
+  if (threads < 0)
+    throw std::invalid_argument("orient_normals: number_of_threads must be >= 0");
+
+  Orientation_result result;
+  result.criterion = internal::name_of(criterion);
+  result.solver = internal::name_of(solver);
+  result.component_sign = internal::name_of(sign_policy);
+
+  // 1. Copy and check the input; normals are normalised for the criteria.
+  const std::size_t n = std::size_t(std::distance(points.begin(), points.end()));
+  result.number_of_points = n;
+  std::vector<Point> pts;
+  std::vector<Vector> nrm;
+  std::vector<char> constrained;
+  pts.reserve(n);
+  nrm.reserve(n);
+  {
+    std::size_t i = 0;
+    for (auto it = points.begin(); it != points.end(); ++it, ++i) {
+      const Point& p = get(point_map, *it);
+      const Vector v = get(normal_map, *it);
+      const double c[6] = {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z()),
+                           CGAL::to_double(v.x()), CGAL::to_double(v.y()), CGAL::to_double(v.z())};
+      for (int d = 0; d < 6; ++d)
+        if (!std::isfinite(c[d])) {
+          std::ostringstream msg;
+          msg << "orient_normals: point " << i << " has a non-finite " << (d < 3 ? "coordinate" : "normal");
+          throw std::invalid_argument(msg.str());
+        }
+      pts.push_back(p);
+      const double l2 = c[3] * c[3] + c[4] * c[4] + c[5] * c[5];
+      if (l2 > 0.0) {
+        const double inv = 1.0 / std::sqrt(l2);
+        nrm.push_back(Vector(c[3] * inv, c[4] * inv, c[5] * inv));
+      } else {
+        nrm.push_back(Vector(0.0, 0.0, 0.0));
+        ++result.number_of_zero_normals;
+      }
+    }
+    if constexpr (has_constraints) {
+      const auto cmap = get_parameter(np, CGAL::internal_np::point_is_constrained);
+      constrained.reserve(n);
+      for (auto it = points.begin(); it != points.end(); ++it)
+        constrained.push_back(get(cmap, *it) ? 1 : 0);
+    }
+  }
+  result.seconds.input = internal::seconds_since(t_start);
+  if (n == 0) {
+    result.seconds.total = internal::seconds_since(t_start);
+    return result;
+  }
+
+  std::vector<Label> labels(n, Label(1));
+  try {
+    internal::run_with_threads(threads, [&]() {
+      const internal::Progress progress(callback);
+      progress.report(0.0);
+
+      // 2. Graph.
+      Neighbor_graph graph;
+      const Neighbor_graph_report gr = build_neighbor_graph<ConcurrencyTag, Kernel>(
+        pts, nrm, k, radius, criterion, graph, progress.stage(0.0, 0.8));
+      result.number_of_edges = gr.number_of_edges;
+      result.number_of_neighbors = gr.number_of_neighbors;
+      result.neighbor_radius = gr.radius;
+      result.radius_estimated = gr.radius_estimated;
+      result.seconds.neighbors = gr.seconds_neighbors;
+      result.seconds.graph = gr.seconds_graph;
+      const auto weight = get(&Neighbor_edge::weight, graph);
+      const auto label_map = CGAL::make_property_map(labels);
+      result.energy_before = energy(graph, weight, label_map);
+
+      // 3. Solve.
+      auto t = std::chrono::steady_clock::now();
+      const Solver_report sr = solver.solve(graph, weight, label_map);
+      result.frustrated_edges = sr.frustrated_edges;
+      result.seconds.solve = internal::seconds_since(t);
+      progress.report(0.9);
+
+      // 4. Components and their signs.
+      t = std::chrono::steady_clock::now();
+      std::vector<std::uint32_t> component;
+      result.number_of_components = connected_components(graph, weight, component);
+      const Component_sign_input<Kernel> input{pts, nrm, labels, component, result.number_of_components,
+                                               gr.radius, has_constraints ? &constrained : nullptr};
+      const std::vector<char> flip = sign_policy(input);
+      for (std::size_t i = 0; i < n; ++i)
+        if (flip[component[i]])
+          labels[i] = Label(-labels[i]);
+      result.energy_after = energy(graph, weight, label_map);
+      result.seconds.sign = internal::seconds_since(t);
+      progress.report(1.0);
+    });
+  } catch (const Interrupted&) {
+    result.interrupted = true;
+    result.seconds.total = internal::seconds_since(t_start);
+    return result;
+  }
+
+  // 5. Write back: only the sign changes.
+  const auto t_out = std::chrono::steady_clock::now();
+  {
+    std::size_t i = 0;
+    for (auto it = points.begin(); it != points.end(); ++it, ++i)
+      if (labels[i] < 0) {
+        put(normal_map, *it, -get(normal_map, *it));
+        if (nrm[i] != CGAL::NULL_VECTOR)
+          ++result.number_of_flipped;
+      }
+  }
+  result.seconds.output = internal::seconds_since(t_out);
+  result.seconds.total = internal::seconds_since(t_start);
+  return result;
+}
+
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_ORIENT_NORMALS_H

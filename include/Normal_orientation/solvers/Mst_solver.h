@@ -1,0 +1,146 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_SOLVERS_MST_SOLVER_H
+#define NORMAL_ORIENTATION_SOLVERS_MST_SOLVER_H
+
+/// \file Mst_solver.h
+/// The maximum-spanning-tree solver on the signed union-find (supplement,
+/// Algorithm 1).
+
+#include <Normal_orientation/Orientation_problem.h>
+#include <Normal_orientation/Signed_union_find.h>
+#include <Normal_orientation/solvers/Solver_report.h>
+
+#include <boost/graph/graph_traits.hpp>
+#include <boost/property_map/property_map.hpp>
+
+#ifdef CGAL_LINKED_WITH_TBB
+#include <tbb/parallel_sort.h>
+#endif
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace Normal_orientation {
+
+/// \ingroup PkgNormalOrientationSolvers
+/// Kruskal's maximum spanning forest with respect to |w|, propagating the
+/// orientation while the forest grows (supplement, Algorithm 1): edges are
+/// taken in decreasing |w|; an edge that joins two components first flips
+/// one of them, in constant time on the signed union-find, if the edge's
+/// wish is not met, then merges them.  Edges inside a component are
+/// ignored, which is why the result can be far from optimal when strong
+/// edges contradict many weaker ones (paper, Figure 2).  It is exact when
+/// the problem is balanced (some labelling meets every edge).
+///
+/// Edges of weight zero carry no information and are skipped, so each
+/// component of the result is a component of the non-zero edges.  Edges are
+/// ranked by |w| rounded to single precision; equal ranks are taken in the
+/// order of `edges(g)`, so the result is deterministic, whatever the number
+/// of threads.  The global sign of every component is left as it comes
+/// (see `Component_sign.h`); vertices without edges get +1.
+///
+/// Cost: O(E log E) for the sort (parallel with TBB), then O(E alpha(V)).
+/// Memory: about 17 bytes per edge and 6 bytes per vertex.
+/// \cgalModels `OrientationSolver`
+class Mst_solver
+{
+public:
+  /// the name used on the command line and in reports
+  static const char* name() { return "mst"; }
+
+  /// Solves the orientation problem on `g` with the signed edge weights
+  /// `weight` and writes +1/-1 to `labels` for every vertex.
+  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
+  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
+  /// \tparam WeightMap a readable edge property map with a floating value
+  /// \tparam LabelMap a writable vertex property map accepting `Label`
+  template <typename Graph, typename WeightMap, typename LabelMap>
+  Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
+  {
+    const auto start = std::chrono::steady_clock::now();
+    typedef typename boost::graph_traits<Graph>::vertex_descriptor vertex_descriptor;
+    typedef typename boost::graph_traits<Graph>::edge_iterator edge_iterator;
+    const std::size_t n = num_vertices(g);
+    auto index = get(boost::vertex_index, g);
+
+    // 1. Gather the informative edges: ends, sign and a 64-bit sort key
+    //    (high word: complement of |w| as float bits, so that larger |w|
+    //    comes first; low word: position, which breaks ties).
+    std::vector<std::uint32_t> tail, head;
+    std::vector<std::uint64_t> keys;
+    std::vector<bool> negative;
+    const std::size_t m_all = std::size_t(num_edges(g));
+    tail.reserve(m_all);
+    head.reserve(m_all);
+    keys.reserve(m_all);
+    negative.reserve(m_all);
+    edge_iterator it, end;
+    for (boost::tie(it, end) = edges(g); it != end; ++it) {
+      const double w = double(get(weight, *it));
+      if (!(w != 0.0))
+        continue; // zero (or NaN) weights carry no information
+      const std::size_t u = std::size_t(get(index, source(*it, g)));
+      const std::size_t v = std::size_t(get(index, target(*it, g)));
+      if (u == v)
+        continue;
+      if (keys.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max()))
+        throw std::length_error("Mst_solver: more than 2^32 - 1 edges");
+      float a = float(std::abs(w));
+      std::uint32_t bits;
+      std::memcpy(&bits, &a, sizeof bits);
+      keys.push_back((std::uint64_t(~bits) << 32) | std::uint64_t(keys.size()));
+      tail.push_back(std::uint32_t(u));
+      head.push_back(std::uint32_t(v));
+      negative.push_back(w < 0.0);
+    }
+
+    // 2. Sort by decreasing |w|; the keys are unique, so the order does not
+    //    depend on the sort algorithm or the number of threads.
+#ifdef CGAL_LINKED_WITH_TBB
+    tbb::parallel_sort(keys.begin(), keys.end());
+#else
+    std::sort(keys.begin(), keys.end());
+#endif
+
+    // 3. Kruskal with orientation propagation on the signed union-find.
+    Signed_union_find uf(n);
+    Solver_report report;
+    for (const std::uint64_t key : keys) {
+      const std::size_t e = std::size_t(key & 0xffffffffu);
+      const auto u = tail[e], v = head[e];
+      if (uf.same_set(u, v))
+        continue;
+      const bool different = uf.sign(u) != uf.sign(v);
+      if (different != bool(negative[e]))
+        uf.flip(v);
+      uf.unite(u, v);
+      ++report.tree_edges;
+    }
+    report.iterations = keys.size();
+
+    // 4. Labels.
+    typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
+    for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit) {
+      const vertex_descriptor vd = *vit;
+      put(labels, vd, Label(uf.sign(std::uint32_t(get(index, vd))) ? -1 : 1));
+    }
+    report.energy = energy(g, weight, labels);
+    for (boost::tie(it, end) = edges(g); it != end; ++it)
+      if (edge_energy(double(get(weight, *it)), get(labels, source(*it, g)),
+                      get(labels, target(*it, g))) > 0.0)
+        ++report.frustrated_edges;
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+  }
+};
+
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_SOLVERS_MST_SOLVER_H

@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_SOLVERS_SOLVER_REPORT_H
+#define NORMAL_ORIENTATION_SOLVERS_SOLVER_REPORT_H
+
+/// \file Solver_report.h
+/// What an `OrientationSolver` returns.
+
+#include <cstddef>
+
+namespace Normal_orientation {
+
+/// \ingroup PkgNormalOrientationSolvers
+/// The report of one solve.
+struct Solver_report
+{
+  /// the energy of the labelling written by the solver
+  double energy = 0.0;
+  /// solver-specific count: edges processed (MST), re-solves (QPBO-I), ...
+  std::size_t iterations = 0;
+  /// edges that joined two different components (MST: the spanning forest)
+  std::size_t tree_edges = 0;
+  /// edges whose wish the labelling does not meet
+  std::size_t frustrated_edges = 0;
+  /// wall-clock seconds of the solve
+  double seconds = 0.0;
+};
+
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_SOLVERS_SOLVER_REPORT_H

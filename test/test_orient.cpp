@@ -1,0 +1,355 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// End-to-end tests of orient_normals(): synthetic shapes with ground truth,
+// property-map variants, input order, determinism, errors, interruption,
+// constraints, and the shared meshes when they are present.
+
+#include "Synthetic_shapes.h"
+
+#include <Normal_orientation/orient_normals.h>
+
+#include <CGAL/Polygon_mesh_processing/IO/polygon_mesh_io.h>
+#include <CGAL/Point_set_3.h>
+#include <CGAL/Surface_mesh.h>
+#include <CGAL/property_map.h>
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+
+namespace NO = Normal_orientation;
+namespace NP = Normal_orientation::parameters;
+using namespace Normal_orientation::test;
+typedef std::pair<Point, Vector> PN;
+typedef CGAL::First_of_pair_property_map<PN> Pmap;
+typedef CGAL::Second_of_pair_property_map<PN> Nmap;
+
+namespace {
+
+auto pn_params() { return NP::point_map(Pmap()).normal_map(Nmap()); }
+
+/// a user's own point type, with its own property maps
+struct My_point
+{
+  int id;
+  Point position;
+  Vector normal;
+};
+struct My_position_map
+{
+  typedef My_point key_type;
+  typedef Point value_type;
+  typedef const Point& reference;
+  typedef boost::readable_property_map_tag category;
+  friend const Point& get(const My_position_map&, const My_point& x) { return x.position; }
+};
+struct My_normal_map
+{
+  typedef My_point key_type;
+  typedef Vector value_type;
+  typedef Vector& reference;
+  typedef boost::lvalue_property_map_tag category;
+  friend Vector& get(const My_normal_map&, My_point& x) { return x.normal; }
+  friend void put(const My_normal_map&, My_point& x, const Vector& v) { x.normal = v; }
+};
+
+/// marks the points of a vector as constrained, by address
+struct Is_fixed
+{
+  typedef PN key_type;
+  typedef bool value_type;
+  typedef bool reference;
+  typedef boost::readable_property_map_tag category;
+  const PN* base;
+  const std::vector<bool>* fixed;
+  friend bool get(const Is_fixed& m, const PN& x) { return (*m.fixed)[std::size_t(&x - m.base)]; }
+};
+
+template <typename Params>
+std::size_t orient_and_count(const std::vector<Sample>& truth, std::vector<PN>& cloud, const Params& np)
+{
+  const NO::Orientation_result r = NO::orient_normals(cloud, np);
+  EXPECT_FALSE(r.interrupted);
+  EXPECT_EQ(r.number_of_points, cloud.size());
+  EXPECT_LE(r.energy_after, r.energy_before);
+  return count_wrong(truth, cloud);
+}
+
+} // namespace
+
+TEST(Orient_normals, SphereComesOutFullyOutward)
+{
+  std::mt19937_64 rng(1);
+  const auto truth = sphere(20000, rng);
+  auto cloud = unoriented(truth, rng, 0.05);
+  EXPECT_EQ(orient_and_count(truth, cloud, pn_params()), 0u);
+}
+
+TEST(Orient_normals, TorusComesOutFullyOutward)
+{
+  std::mt19937_64 rng(2);
+  const auto truth = torus(20000, rng);
+  auto cloud = unoriented(truth, rng, 0.05);
+  EXPECT_EQ(orient_and_count(truth, cloud, pn_params()), 0u);
+}
+
+TEST(Orient_normals, TwoDisjointSpheresEachComeOutOutward)
+{
+  std::mt19937_64 rng(3);
+  auto truth = sphere(8000, rng, Point(-3, 0, 0), 1.0);
+  const auto second = sphere(12000, rng, Point(3, 1, 0), 1.5);
+  truth.insert(truth.end(), second.begin(), second.end());
+  auto cloud = unoriented(truth, rng, 0.05);
+  const auto r = NO::orient_normals(cloud, pn_params());
+  EXPECT_EQ(r.number_of_components, 2u);
+  EXPECT_EQ(count_wrong(truth, cloud), 0u);
+}
+
+TEST(Orient_normals, BoxWithSharpCreasesComesOutOutwardWithXie)
+{
+  std::mt19937_64 rng(4);
+  const auto truth = box(30000, rng, 1.0, 1.5, 0.8);
+  auto cloud = unoriented(truth, rng);
+  EXPECT_EQ(orient_and_count(truth, cloud, pn_params().flip_criterion(NO::Xie_criterion())), 0u);
+}
+
+TEST(Orient_normals, ThinSlabComesOutOutwardWithXie)
+{
+  // 2 x 2 faces, 0.06 thick: about three point spacings
+  std::mt19937_64 rng(5);
+  const auto truth = box(24000, rng, 2.0, 2.0, 0.06);
+  auto cloud = unoriented(truth, rng);
+  EXPECT_EQ(orient_and_count(truth, cloud, pn_params().flip_criterion(NO::Xie_criterion())), 0u);
+}
+
+TEST(Orient_normals, ThinSlabDefeatsHoppe)
+{
+  // The same slab with Hoppe's criterion: edges across the slab ask the two
+  // sheets to agree, which is wrong.  This documents why Xie is needed there.
+  std::mt19937_64 rng(5);
+  const auto truth = box(24000, rng, 2.0, 2.0, 0.06);
+  auto cloud = unoriented(truth, rng);
+  const auto wrong = orient_and_count(truth, cloud, pn_params().number_of_neighbors(30));
+  EXPECT_GT(wrong, truth.size() / 20);
+}
+
+TEST(Orient_normals, InputOrderAndNormalMagnitudesAreKept)
+{
+  std::mt19937_64 rng(6);
+  const auto truth = sphere(3000, rng);
+  auto cloud = unoriented(truth, rng, 0.1);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    cloud[i].second = cloud[i].second * (1.0 + double(i % 7)); // non-unit normals
+  const auto before = cloud;
+  NO::orient_normals(cloud, pn_params());
+  ASSERT_EQ(cloud.size(), before.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    ASSERT_EQ(cloud[i].first, before[i].first);
+    ASSERT_TRUE(cloud[i].second == before[i].second || cloud[i].second == -before[i].second);
+  }
+}
+
+TEST(Orient_normals, SameResultWithOneAndTwoThreadsAndSequentially)
+{
+  std::mt19937_64 rng(7);
+  auto truth = torus(15000, rng);
+  const auto noisy_half = sphere(5000, rng, Point(3, 0, 0), 0.5);
+  truth.insert(truth.end(), noisy_half.begin(), noisy_half.end());
+  const auto input = unoriented(truth, rng, 0.3); // noisy: a frustrated problem
+  auto a = input, b = input, c = input;
+  const auto ra = NO::orient_normals(a, pn_params().number_of_threads(1));
+  const auto rb = NO::orient_normals(b, pn_params().number_of_threads(2));
+  const auto rc = NO::orient_normals<CGAL::Sequential_tag>(c, pn_params());
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(a, c);
+  EXPECT_EQ(ra.energy_after, rb.energy_after);
+  EXPECT_EQ(ra.number_of_edges, rc.number_of_edges);
+  EXPECT_EQ(ra.neighbor_radius, rb.neighbor_radius);
+}
+
+TEST(Orient_normals, WorksWithPointSet3AndUserStructures)
+{
+  std::mt19937_64 rng(8);
+  const auto truth = sphere(5000, rng);
+  const auto input = unoriented(truth, rng, 0.05);
+
+  CGAL::Point_set_3<Point> ps;
+  ps.add_normal_map();
+  for (const auto& x : input)
+    ps.insert(x.first, x.second);
+  NO::orient_normals(ps, ps.parameters());
+  std::size_t wrong = 0, i = 0;
+  for (auto it = ps.begin(); it != ps.end(); ++it, ++i)
+    wrong += truth[i].n * ps.normal(*it) <= 0.0;
+  EXPECT_EQ(wrong, 0u);
+
+  // the package's own names chained to a CGAL pack
+  CGAL::Point_set_3<Point> ps2 = ps;
+  for (auto it = ps2.begin(); it != ps2.end(); ++it)
+    ps2.normal(*it) = -ps2.normal(*it);
+  const auto r = NO::orient_normals(ps2, NP::extend(ps2.parameters()).number_of_neighbors(6));
+  EXPECT_EQ(r.number_of_neighbors, 6u);
+  i = 0;
+  for (auto it = ps2.begin(); it != ps2.end(); ++it, ++i)
+    ASSERT_GT(truth[i].n * ps2.normal(*it), 0.0);
+
+  std::vector<My_point> mine;
+  for (const auto& x : input)
+    mine.push_back({int(mine.size()), x.first, x.second});
+  NO::orient_normals(mine, NP::point_map(My_position_map()).normal_map(My_normal_map()));
+  for (std::size_t j = 0; j < mine.size(); ++j) {
+    ASSERT_EQ(mine[j].id, int(j));
+    ASSERT_GT(truth[j].n * mine[j].normal, 0.0);
+  }
+}
+
+TEST(Orient_normals, BadInputRaisesClearErrorsAndChangesNothing)
+{
+  std::mt19937_64 rng(9);
+  const auto truth = sphere(500, rng);
+  auto cloud = unoriented(truth, rng);
+  const auto before = cloud;
+  EXPECT_THROW(NO::orient_normals(cloud, pn_params().number_of_neighbors(0)), std::invalid_argument);
+  EXPECT_THROW(NO::orient_normals(cloud, pn_params().neighbor_radius(-1.0)), std::invalid_argument);
+  EXPECT_THROW(NO::orient_normals(cloud, pn_params().neighbor_radius(std::nan(""))), std::invalid_argument);
+  EXPECT_THROW(NO::orient_normals(cloud, pn_params().number_of_threads(-2)), std::invalid_argument);
+  EXPECT_EQ(cloud, before);
+
+  auto bad = cloud;
+  bad[123].first = Point(0, std::nan(""), 0);
+  try {
+    NO::orient_normals(bad, pn_params());
+    FAIL() << "no exception for a NaN coordinate";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("point 123"), std::string::npos) << e.what();
+  }
+  bad = cloud;
+  bad[7].second = Vector(std::numeric_limits<double>::infinity(), 0, 0);
+  EXPECT_THROW(NO::orient_normals(bad, pn_params()), std::invalid_argument);
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (i != 7)
+      ASSERT_EQ(bad[i], cloud[i]);
+}
+
+TEST(Orient_normals, DegenerateCloudsAreHandled)
+{
+  std::vector<PN> empty;
+  EXPECT_EQ(NO::orient_normals(empty, pn_params()).number_of_points, 0u);
+
+  std::vector<PN> one{{Point(1, 2, 3), Vector(0, 0, 1)}};
+  EXPECT_EQ(NO::orient_normals(one, pn_params()).number_of_edges, 0u);
+  EXPECT_EQ(one[0].second, Vector(0, 0, 1));
+
+  // fewer points than k: k is lowered to n - 1
+  std::mt19937_64 rng(10);
+  const auto truth = sphere(6, rng);
+  auto few = unoriented(truth, rng);
+  const auto r = NO::orient_normals(few, pn_params().number_of_neighbors(10));
+  EXPECT_EQ(r.number_of_neighbors, 5u);
+
+  // duplicates and zero normals: finite energies, zero normals kept
+  const auto base = sphere(2000, rng);
+  auto dup = unoriented(base, rng);
+  const auto copy = dup;
+  dup.insert(dup.end(), copy.begin(), copy.end());
+  dup[5].second = Vector(0, 0, 0);
+  const auto rd = NO::orient_normals(dup, pn_params());
+  EXPECT_TRUE(std::isfinite(rd.energy_before) && std::isfinite(rd.energy_after));
+  EXPECT_EQ(rd.number_of_zero_normals, 1u);
+  EXPECT_EQ(dup[5].second, Vector(0, 0, 0));
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < dup.size(); ++i)
+    if (i != 5)
+      wrong += base[i % base.size()].n * dup[i].second <= 0.0;
+  EXPECT_EQ(wrong, 0u);
+
+  // every point at the same place
+  std::vector<PN> same(50, {Point(1, 1, 1), Vector(0, 0, 1)});
+  for (std::size_t i = 0; i < same.size(); i += 2)
+    same[i].second = Vector(0, 0, -1);
+  const auto rs = NO::orient_normals(same, pn_params());
+  EXPECT_EQ(rs.energy_after, 0.0);
+}
+
+TEST(Orient_normals, CallbackReportsProgressAndInterrupts)
+{
+  std::mt19937_64 rng(11);
+  const auto truth = sphere(100000, rng);
+  auto cloud = unoriented(truth, rng);
+  const auto before = cloud;
+  std::vector<double> seen;
+  std::function<bool(double)> stop = [&](double x) {
+    seen.push_back(x);
+    return x < 0.3;
+  };
+  const auto r = NO::orient_normals(cloud, pn_params().callback(stop));
+  EXPECT_TRUE(r.interrupted);
+  EXPECT_EQ(cloud, before);
+  ASSERT_FALSE(seen.empty());
+  EXPECT_GE(seen.back(), 0.3);
+
+  seen.clear();
+  std::function<bool(double)> watch = [&](double x) {
+    seen.push_back(x);
+    return true;
+  };
+  EXPECT_FALSE(NO::orient_normals(cloud, pn_params().callback(watch)).interrupted);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_EQ(seen.back(), 1.0);
+}
+
+TEST(Orient_normals, ConstraintsAndViewpointDecideTheSign)
+{
+  std::mt19937_64 rng(12);
+  const auto truth = sphere(5000, rng);
+  auto cloud = unoriented(truth, rng, 0.05);
+  // point 17 is declared correct while pointing inward: the whole sphere
+  // must follow it
+  cloud[17].second = -truth[17].n;
+  std::vector<bool> fixed(cloud.size(), false);
+  fixed[17] = true;
+  const PN* base = cloud.data();
+  auto inward = cloud;
+  NO::orient_normals(cloud, pn_params().point_is_constrained_map(Is_fixed{base, &fixed}));
+  EXPECT_EQ(count_wrong(truth, cloud), cloud.size());
+
+  NO::orient_normals(inward, pn_params().component_sign(NO::Viewpoint_component_sign(0, 0, 0)));
+  EXPECT_EQ(count_wrong(truth, inward), inward.size());
+}
+
+TEST(Orient_normals, SharedMeshesWhenPresent)
+{
+  const std::filesystem::path mesh = std::filesystem::path(NORMAL_ORIENTATION_SHARED_DATA_DIR) / "meshes" / "knot.off";
+  if (!std::filesystem::exists(mesh))
+    GTEST_SKIP() << "no shared data at " << mesh;
+  CGAL::Surface_mesh<Point> sm;
+  ASSERT_TRUE(CGAL::IO::read_polygon_mesh(mesh.string(), sm));
+  std::vector<double> cumulative;
+  std::vector<CGAL::Surface_mesh<Point>::Face_index> faces;
+  double total = 0.0;
+  for (auto f : sm.faces()) {
+    auto h = sm.halfedge(f);
+    const Point a = sm.point(sm.source(h)), b = sm.point(sm.target(h)), c = sm.point(sm.target(sm.next(h)));
+    total += std::sqrt(CGAL::cross_product(b - a, c - a).squared_length()) / 2.0;
+    cumulative.push_back(total);
+    faces.push_back(f);
+  }
+  std::mt19937_64 rng(13);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Sample> truth;
+  for (int i = 0; i < 30000; ++i) {
+    const std::size_t t = std::size_t(std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total) -
+                                      cumulative.begin());
+    auto h = sm.halfedge(faces[std::min(t, faces.size() - 1)]);
+    const Point a = sm.point(sm.source(h)), b = sm.point(sm.target(h)), c = sm.point(sm.target(sm.next(h)));
+    double s = u(rng), v = u(rng);
+    if (s + v > 1.0) {
+      s = 1.0 - s;
+      v = 1.0 - v;
+    }
+    truth.push_back({a + s * (b - a) + v * (c - a), unit(CGAL::cross_product(b - a, c - a))});
+  }
+  auto cloud = unoriented(truth, rng, 0.05);
+  const std::size_t wrong = orient_and_count(truth, cloud, pn_params());
+  EXPECT_LT(wrong, truth.size() / 100) << wrong << " wrong normals of " << truth.size();
+}
