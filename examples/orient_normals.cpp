@@ -21,6 +21,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <numeric>
 #include <sstream>
@@ -349,6 +350,7 @@ int main_impl(int argc, char** argv)
   const auto tw = std::chrono::steady_clock::now();
   NO::IO::Write_options wo;
   wo.binary = !o.ascii;
+  wo.precision = 0; // shortest text that reads back exactly: the output loses nothing
   NO::IO::write_point_cloud(o.output, cloud, wo);
   const double write_seconds = since(tw);
   const double total_seconds = since(t0);
@@ -361,7 +363,9 @@ int main_impl(int argc, char** argv)
                  r.number_of_neighbors, r.neighbor_radius, r.number_of_components,
                  r.number_of_components == 1 ? "" : "s", r.energy_before, r.energy_after, r.number_of_flipped,
                  total_seconds);
-    std::fprintf(stderr, "wrote %s\n", o.output.c_str());
+    std::error_code ec;
+    const std::string where = std::filesystem::absolute(o.output, ec).string();
+    std::fprintf(stderr, "wrote %s\n", ec ? o.output.c_str() : where.c_str());
   }
   if (o.json) {
     std::printf("{\"input\": \"%s\", \"output\": \"%s\", \"points\": %zu, \"edges\": %zu, \"components\": %zu, "

@@ -1,0 +1,825 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+/// \file test_io.cpp
+/// \brief Tests of Normal_orientation/IO/Point_cloud_io.h: reading and writing `.xyz`,
+/// `.pwn` and `.ply` point clouds, error reporting and atomic writing.
+
+#include <Normal_orientation/IO/Point_cloud_io.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+namespace {
+
+namespace fs = std::filesystem;
+using Normal_orientation::IO::Io_error;
+using Normal_orientation::IO::Ply_property;
+using Normal_orientation::IO::Ply_scalar_type;
+using Normal_orientation::IO::Point_cloud;
+using Normal_orientation::IO::Write_options;
+using Normal_orientation::IO::read_point_cloud;
+using Normal_orientation::IO::write_point_cloud;
+
+/// \brief A fresh temporary directory, removed with its content on destruction.
+class Temporary_directory
+{
+public:
+  Temporary_directory()
+  {
+    static std::atomic<int> counter{0};
+    const std::string name = "normal_orientation_test_io_" + std::to_string(::getpid()) + "_" +
+                             std::to_string(counter++) + "_" +
+                             ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    path_ = fs::temp_directory_path() / name;
+    fs::remove_all(path_);
+    fs::create_directories(path_);
+  }
+  ~Temporary_directory()
+  {
+    std::error_code error;
+    fs::remove_all(path_, error);
+  }
+  Temporary_directory(const Temporary_directory&) = delete;
+  Temporary_directory& operator=(const Temporary_directory&) = delete;
+
+  /// Full name of file `name` in the directory.
+  std::string file(const std::string& name) const { return (path_ / name).string(); }
+  /// Names of the files in the directory, sorted.
+  std::vector<std::string> listing() const
+  {
+    std::vector<std::string> names;
+    for(const fs::directory_entry& entry : fs::directory_iterator(path_))
+      names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  /// Returns `true` if a temporary file (`*.tmp.*`) is in the directory.
+  bool has_temporary_file() const
+  {
+    for(const std::string& name : listing())
+      if(name.find(".tmp.") != std::string::npos) return true;
+    return false;
+  }
+
+private:
+  fs::path path_;
+};
+
+/// \brief Writes `content` to `filename` as is.
+void write_file(const std::string& filename, const std::string& content)
+{
+  std::ofstream out(filename, std::ios::binary);
+  out.write(content.data(), static_cast<std::streamsize>(content.size()));
+  ASSERT_TRUE(out.good()) << filename;
+}
+
+/// \brief Content of `filename`.
+std::string file_content(const std::string& filename)
+{
+  std::ifstream in(filename, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// \brief Builds binary PLY data.
+struct Bytes
+{
+  std::string data;
+  bool big_endian = false;
+
+  template <class T>
+  Bytes& operator<<(T value)
+  {
+    unsigned char raw[sizeof(T)];
+    std::memcpy(raw, &value, sizeof(T));
+    const std::uint16_t one = 1;
+    unsigned char first = 0;
+    std::memcpy(&first, &one, 1);
+    const bool host_little = first == 1;
+    if(host_little == big_endian) std::reverse(raw, raw + sizeof(T));
+    data.append(reinterpret_cast<const char*>(raw), sizeof(T));
+    return *this;
+  }
+};
+
+/// \brief Checks that `action` throws an Io_error whose message contains `filename`
+/// and `expected`.
+void expect_io_error(const std::function<void()>& action, const std::string& filename,
+                     const std::string& expected)
+{
+  try {
+    action();
+    ADD_FAILURE() << "no Io_error thrown, expected '" << expected << "' for " << filename;
+  } catch(const Io_error& error) {
+    const std::string message = error.what();
+    EXPECT_NE(message.find(filename), std::string::npos) << message;
+    EXPECT_NE(message.find(expected), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  } catch(const std::exception& error) {
+    ADD_FAILURE() << "unexpected exception: " << error.what();
+  }
+}
+
+/// \brief Checks that reading `filename` with content `content` throws an Io_error
+/// naming the file and containing `expected`.
+void expect_read_error(const Temporary_directory& directory, const std::string& name,
+                       const std::string& content, const std::string& expected)
+{
+  const std::string filename = directory.file(name);
+  write_file(filename, content);
+  expect_io_error([&] { read_point_cloud(filename); }, filename, expected);
+}
+
+/// \brief A small cloud with awkward values.
+Point_cloud sample_cloud(bool with_normals)
+{
+  Point_cloud cloud;
+  for(int i = 0; i < 50; ++i) {
+    const double t = i * 0.731;
+    cloud.points.push_back({{std::sin(t) * 1e3, std::cos(t) / 3.0, -t * 1e-7 + 0.1}});
+    if(with_normals) cloud.normals.push_back({{std::sin(t), -std::cos(t), i == 7 ? 0.0 : 1.0 / (i + 1)}});
+  }
+  cloud.points.push_back({{0.0, -0.0, 1e-300}});
+  if(with_normals) cloud.normals.push_back({{0.0, 0.0, 0.0}});
+  return cloud;
+}
+
+/// \brief Adds uchar colours and other extra properties to `cloud`.
+void add_extra_properties(Point_cloud& cloud)
+{
+  cloud.extra_properties = {{"red", Ply_scalar_type::UINT8},      {"green", Ply_scalar_type::UINT8},
+                            {"blue", Ply_scalar_type::UINT8},     {"label", Ply_scalar_type::INT32},
+                            {"quality", Ply_scalar_type::FLOAT32}, {"density", Ply_scalar_type::FLOAT64},
+                            {"flag", Ply_scalar_type::INT8},      {"id", Ply_scalar_type::UINT32},
+                            {"s", Ply_scalar_type::INT16},        {"u", Ply_scalar_type::UINT16}};
+  for(std::size_t i = 0; i < cloud.size(); ++i) {
+    const double d = static_cast<double>(i);
+    const std::vector<double> row = {std::fmod(d * 37, 256), 255, 0, -d * 1000,
+                                     static_cast<double>(static_cast<float>(d / 7)), d / 3 + 1e-12,
+                                     -128 + std::fmod(d, 256), 4294967295.0 - d, -32768 + d, 65535 - d};
+    cloud.extra_values.insert(cloud.extra_values.end(), row.begin(), row.end());
+  }
+}
+
+void expect_same_points(const Point_cloud& a, const Point_cloud& b)
+{
+  ASSERT_EQ(a.points.size(), b.points.size());
+  ASSERT_EQ(a.normals.size(), b.normals.size());
+  for(std::size_t i = 0; i < a.points.size(); ++i) {
+    EXPECT_EQ(a.points[i], b.points[i]) << "point " << i;
+    if(a.has_normals()) {
+      EXPECT_EQ(a.normals[i], b.normals[i]) << "normal " << i;
+    }
+  }
+}
+
+void expect_same_extras(const Point_cloud& a, const Point_cloud& b)
+{
+  ASSERT_EQ(a.extra_properties.size(), b.extra_properties.size());
+  for(std::size_t k = 0; k < a.extra_properties.size(); ++k) {
+    EXPECT_EQ(a.extra_properties[k].name, b.extra_properties[k].name);
+    EXPECT_EQ(a.extra_properties[k].type, b.extra_properties[k].type) << a.extra_properties[k].name;
+  }
+  ASSERT_EQ(a.extra_values.size(), b.extra_values.size());
+  for(std::size_t j = 0; j < a.extra_values.size(); ++j)
+    EXPECT_EQ(a.extra_values[j], b.extra_values[j]) << "extra value " << j;
+}
+
+} // namespace
+
+// --------------------------------------------------------------------------- xyz
+
+TEST(Point_cloud_io, xyz_round_trip_with_normals)
+{
+  Temporary_directory directory;
+  const Point_cloud cloud = sample_cloud(true);
+  Write_options exact;
+  exact.precision = 0;
+  write_point_cloud(directory.file("a.xyz"), cloud, exact);
+  const Point_cloud read = read_point_cloud(directory.file("a.xyz"));
+  EXPECT_TRUE(read.has_normals());
+  EXPECT_EQ(read.size(), cloud.size());
+  expect_same_points(cloud, read);
+
+  // Default precision: 9 significant digits.
+  write_point_cloud(directory.file("b.xyz"), cloud);
+  const Point_cloud rounded = read_point_cloud(directory.file("b.xyz"));
+  ASSERT_EQ(rounded.size(), cloud.size());
+  for(std::size_t i = 0; i < cloud.size(); ++i)
+    for(std::size_t c = 0; c < 3; ++c) {
+      EXPECT_NEAR(rounded.points[i][c], cloud.points[i][c], 1e-8 * std::fabs(cloud.points[i][c]));
+      EXPECT_NEAR(rounded.normals[i][c], cloud.normals[i][c], 1e-8 * std::fabs(cloud.normals[i][c]));
+    }
+  EXPECT_EQ(file_content(directory.file("b.xyz")).substr(0, 2), "0 ");
+  EXPECT_FALSE(directory.has_temporary_file());
+}
+
+TEST(Point_cloud_io, xyz_round_trip_without_normals)
+{
+  Temporary_directory directory;
+  const Point_cloud cloud = sample_cloud(false);
+  Write_options exact;
+  exact.precision = -1;
+  write_point_cloud(directory.file("a.xyz"), cloud, exact);
+  const Point_cloud read = read_point_cloud(directory.file("a.xyz"));
+  EXPECT_FALSE(read.has_normals());
+  expect_same_points(cloud, read);
+  // Three values per line.
+  const std::string text = file_content(directory.file("a.xyz"));
+  const std::string first_line = text.substr(0, text.find('\n'));
+  EXPECT_EQ(std::count(first_line.begin(), first_line.end(), ' '), 2) << first_line;
+}
+
+TEST(Point_cloud_io, xyz_comments_blank_lines_and_line_endings)
+{
+  Temporary_directory directory;
+  const std::string filename = directory.file("c.xyz");
+  write_file(filename, "# a comment\n\n   # indented comment\r\n1 2 3 0 0 1\r\n"
+                       "\t-1.5\t+2e3   .25  0 0 0 \n   \n1e-3 -0 7 0.5 -0.5 0");
+  const Point_cloud cloud = read_point_cloud(filename);
+  ASSERT_EQ(cloud.size(), 3u);
+  ASSERT_TRUE(cloud.has_normals());
+  EXPECT_EQ(cloud.points[0], (std::array<double, 3>{{1, 2, 3}}));
+  EXPECT_EQ(cloud.normals[0], (std::array<double, 3>{{0, 0, 1}}));
+  EXPECT_EQ(cloud.points[1], (std::array<double, 3>{{-1.5, 2000, 0.25}}));
+  EXPECT_EQ(cloud.normals[1], (std::array<double, 3>{{0, 0, 0}})); // zero normals are allowed
+  EXPECT_EQ(cloud.points[2], (std::array<double, 3>{{1e-3, 0, 7}}));
+  EXPECT_TRUE(std::signbit(cloud.points[2][1]));
+  EXPECT_EQ(cloud.normals[2], (std::array<double, 3>{{0.5, -0.5, 0}}));
+}
+
+TEST(Point_cloud_io, xyz_number_syntax)
+{
+  Temporary_directory directory;
+  write_file(directory.file("n.xyz"), "1. .5 +.25\n1e+05 -0.0e0 7E-3\n0012 1e0 -1.5e-310\n");
+  const Point_cloud cloud = read_point_cloud(directory.file("n.xyz"));
+  ASSERT_EQ(cloud.size(), 3u);
+  EXPECT_EQ(cloud.points[0], (std::array<double, 3>{{1.0, 0.5, 0.25}}));
+  EXPECT_EQ(cloud.points[1], (std::array<double, 3>{{1e5, 0.0, 7e-3}}));
+  EXPECT_EQ(cloud.points[2], (std::array<double, 3>{{12.0, 1.0, -1.5e-310}}));
+  expect_read_error(directory, "e.xyz", "1 2 1e\n", "non-numeric token '1e' at line 1");
+  expect_read_error(directory, "hex.xyz", "1 2 0x10\n", "non-numeric token '0x10' at line 1");
+  expect_read_error(directory, "plus_minus.xyz", "1 2 +-3\n", "non-numeric token '+-3' at line 1");
+  expect_read_error(directory, "dot.xyz", "1 2 .\n", "non-numeric token '.' at line 1");
+}
+
+TEST(Point_cloud_io, fast_formatting_matches_to_chars)
+{
+  using Normal_orientation::IO::internal::format_general_fast;
+  std::uint64_t state = 12345;
+  auto next = [&state] { // xorshift64*
+    state ^= state >> 12;
+    state ^= state << 25;
+    state ^= state >> 27;
+    return state * 2685821657736338717ull;
+  };
+  std::size_t fast = 0;
+  auto check = [&fast](double value, int precision) {
+    char expected[64];
+    char actual[64];
+    const std::to_chars_result result =
+      std::to_chars(expected, expected + 64, value, std::chars_format::general, precision);
+    if(char* end = format_general_fast(actual, value, precision)) {
+      ++fast;
+      ASSERT_EQ(std::string(expected, result.ptr), std::string(actual, end))
+        << "precision " << precision << " value " << std::string(expected, result.ptr);
+    }
+  };
+  for(int i = 0; i < 300000; ++i) {
+    const double mantissa = static_cast<double>(next() >> 11) / 9007199254740992.0 * 2.0 - 1.0;
+    const int exponent = static_cast<int>(next() % 61) - 30;
+    check(mantissa * std::pow(10.0, exponent), 1 + static_cast<int>(next() % 12));
+  }
+  // Powers of ten, short decimals and ties, and their neighbours.
+  for(int precision = 1; precision <= 12; ++precision)
+    for(int exponent = -12; exponent <= 22; exponent += 3)
+      for(int m = 1; m < 200; ++m)
+        for(double value : {m * std::pow(10.0, exponent), (m + 0.5) * std::pow(10.0, exponent)}) {
+          check(value, precision);
+          check(-value, precision);
+          check(std::nextafter(value, 0.0), precision);
+          check(std::nextafter(value, 1e300), precision);
+        }
+  for(double value : {0.0, -0.0, 1e-300, 1e300, 5e-324, std::numeric_limits<double>::max()})
+    for(int precision = 1; precision <= 12; ++precision) check(value, precision);
+  EXPECT_GT(fast, 300000u); // most values take the fast path
+}
+
+TEST(Point_cloud_io, pwn_and_upper_case_extensions)
+{
+  Temporary_directory directory;
+  write_file(directory.file("a.PWN"), "1 2 3 0 1 0\n4 5 6 1 0 0\n");
+  const Point_cloud cloud = read_point_cloud(directory.file("a.PWN"));
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(cloud.normals[1], (std::array<double, 3>{{1, 0, 0}}));
+  write_point_cloud(directory.file("b.Xyz"), cloud);
+  write_point_cloud(directory.file("c.pwn"), cloud);
+  write_point_cloud(directory.file("d.PLY"), cloud);
+  expect_same_points(cloud, read_point_cloud(directory.file("b.Xyz")));
+  expect_same_points(cloud, read_point_cloud(directory.file("c.pwn")));
+  expect_same_points(cloud, read_point_cloud(directory.file("d.PLY")));
+}
+
+TEST(Point_cloud_io, empty_files)
+{
+  Temporary_directory directory;
+  write_file(directory.file("e.xyz"), "# nothing\n\n");
+  EXPECT_EQ(read_point_cloud(directory.file("e.xyz")).size(), 0u);
+  write_file(directory.file("e.ply"), "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\n"
+                                      "property float y\nproperty float z\nend_header\n");
+  EXPECT_EQ(read_point_cloud(directory.file("e.ply")).size(), 0u);
+  const Point_cloud empty;
+  write_point_cloud(directory.file("f.ply"), empty);
+  write_point_cloud(directory.file("f.xyz"), empty);
+  EXPECT_EQ(read_point_cloud(directory.file("f.ply")).size(), 0u);
+  EXPECT_EQ(read_point_cloud(directory.file("f.xyz")).size(), 0u);
+  EXPECT_EQ(file_content(directory.file("f.xyz")), "");
+}
+
+// --------------------------------------------------------------------------- ply reading
+
+TEST(Point_cloud_io, ply_ascii_with_colours_and_faces)
+{
+  Temporary_directory directory;
+  const std::string filename = directory.file("a.ply");
+  write_file(filename, "ply\r\n"
+                       "format ascii 1.0\r\n"
+                       "comment made by hand\r\n"
+                       "obj_info nothing\r\n"
+                       "element vertex 3\r\n"
+                       "property float x\r\n"
+                       "property float y\r\n"
+                       "property float z\r\n"
+                       "property uchar red\r\n"
+                       "property uchar green\r\n"
+                       "property uchar blue\r\n"
+                       "property float nx\r\n"
+                       "property float ny\r\n"
+                       "property float nz\r\n"
+                       "element face 2\r\n"
+                       "property list uchar int vertex_indices\r\n"
+                       "end_header\r\n"
+                       "0 0 0 255 0 0 0 0 1\r\n"
+                       "1.5 0 0 0 255 0 0 1 0\r\n"
+                       "0.1 1 -2 0 0 255 1 0 0\r\n"
+                       "3 0 1 2\r\n"
+                       "3 2 1 0\r\n");
+  const Point_cloud cloud = read_point_cloud(filename);
+  ASSERT_EQ(cloud.size(), 3u);
+  ASSERT_TRUE(cloud.has_normals());
+  EXPECT_EQ(cloud.points[1], (std::array<double, 3>{{1.5, 0, 0}}));
+  EXPECT_EQ(cloud.points[2][0], static_cast<double>(0.1f)); // float property: rounded to float
+  EXPECT_EQ(cloud.points[2][2], -2.0);
+  EXPECT_EQ(cloud.normals[0], (std::array<double, 3>{{0, 0, 1}}));
+  EXPECT_EQ(cloud.normals[2], (std::array<double, 3>{{1, 0, 0}}));
+  ASSERT_EQ(cloud.extra_properties.size(), 3u);
+  EXPECT_EQ(cloud.extra_properties[0].name, "red");
+  EXPECT_EQ(cloud.extra_properties[1].name, "green");
+  EXPECT_EQ(cloud.extra_properties[2].name, "blue");
+  EXPECT_EQ(cloud.extra_properties[2].type, Ply_scalar_type::UINT8);
+  EXPECT_EQ(cloud.extra_values, (std::vector<double>{255, 0, 0, 0, 255, 0, 0, 0, 255}));
+  EXPECT_EQ(cloud.point_types[0], Ply_scalar_type::FLOAT32);
+  EXPECT_EQ(cloud.normal_types[2], Ply_scalar_type::FLOAT32);
+}
+
+TEST(Point_cloud_io, ply_binary_little_endian_written_byte_by_byte)
+{
+  Temporary_directory directory;
+  const std::string filename = directory.file("hand.ply");
+  std::string content = "ply\n"
+                        "format binary_little_endian 1.0\n"
+                        "element vertex 2\n"
+                        "property float x\n"
+                        "property float y\n"
+                        "property float z\n"
+                        "property uchar red\n"
+                        "property uchar green\n"
+                        "property uchar blue\n"
+                        "element face 1\n"
+                        "property list uchar int vertex_indices\n"
+                        "end_header\n";
+  const unsigned char data[] = {
+    // vertex 0: x = 1.0f, y = -2.0f, z = 0.5f, colour (255, 128, 0)
+    0x00, 0x00, 0x80, 0x3f, 0x00, 0x00, 0x00, 0xc0, 0x00, 0x00, 0x00, 0x3f, 0xff, 0x80, 0x00,
+    // vertex 1: x = 0.0f, y = 3.0f, z = -0.25f, colour (1, 2, 3)
+    0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x40, 0x40, 0x00, 0x00, 0x80, 0xbe, 0x01, 0x02, 0x03,
+    // face 0: 3 indices 0 1 1 (int, little endian)
+    0x03, 0x00, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00, 0x01, 0x00, 0x00, 0x00};
+  content.append(reinterpret_cast<const char*>(data), sizeof(data));
+  write_file(filename, content);
+
+  const Point_cloud cloud = read_point_cloud(filename);
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_FALSE(cloud.has_normals());
+  EXPECT_EQ(cloud.points[0], (std::array<double, 3>{{1.0, -2.0, 0.5}}));
+  EXPECT_EQ(cloud.points[1], (std::array<double, 3>{{0.0, 3.0, -0.25}}));
+  ASSERT_EQ(cloud.extra_properties.size(), 3u);
+  EXPECT_EQ(cloud.extra_values, (std::vector<double>{255, 128, 0, 1, 2, 3}));
+
+  // The same file cut in the middle of the face is truncated.
+  write_file(directory.file("cut.ply"), content.substr(0, content.size() - 2));
+  expect_io_error([&] { read_point_cloud(directory.file("cut.ply")); }, directory.file("cut.ply"),
+                  "truncated file: element 'face' declares 1 rows, data end at row 0");
+}
+
+TEST(Point_cloud_io, ply_binary_big_endian_double_with_face_before_vertex)
+{
+  Temporary_directory directory;
+  const std::string filename = directory.file("be.ply");
+  Bytes bytes;
+  bytes.big_endian = true;
+  bytes.data = "ply\nformat binary_big_endian 1.0\ncomment faces first\n"
+               "element face 2\nproperty list ushort uint vertex_indices\nproperty uchar flags\n"
+               "element vertex 2\nproperty double x\nproperty double y\nproperty double z\n"
+               "property double nx\nproperty double ny\nproperty double nz\nproperty uint8 red\n"
+               "property uint8 green\nproperty uint8 blue\n"
+               "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n";
+  // faces: a triangle and a quad
+  bytes << std::uint16_t(3) << std::uint32_t(0) << std::uint32_t(1) << std::uint32_t(0) << std::uint8_t(7);
+  bytes << std::uint16_t(4) << std::uint32_t(1) << std::uint32_t(0) << std::uint32_t(1) << std::uint32_t(0)
+        << std::uint8_t(9);
+  // vertices
+  bytes << 0.1 << -1e300 << 3.0 << 0.0 << 0.0 << -1.0 << std::uint8_t(10) << std::uint8_t(20) << std::uint8_t(30);
+  bytes << 1.0 / 3 << 2.0 << -0.0 << 0.6 << 0.8 << 0.0 << std::uint8_t(0) << std::uint8_t(1) << std::uint8_t(255);
+  // edge
+  bytes << std::int32_t(0) << std::int32_t(1);
+  write_file(filename, bytes.data);
+
+  const Point_cloud cloud = read_point_cloud(filename);
+  ASSERT_EQ(cloud.size(), 2u);
+  ASSERT_TRUE(cloud.has_normals());
+  EXPECT_EQ(cloud.points[0], (std::array<double, 3>{{0.1, -1e300, 3.0}}));
+  EXPECT_EQ(cloud.points[1], (std::array<double, 3>{{1.0 / 3, 2.0, 0.0}}));
+  EXPECT_EQ(cloud.normals[0], (std::array<double, 3>{{0, 0, -1}}));
+  EXPECT_EQ(cloud.normals[1], (std::array<double, 3>{{0.6, 0.8, 0}}));
+  EXPECT_EQ(cloud.extra_values, (std::vector<double>{10, 20, 30, 0, 1, 255}));
+  EXPECT_EQ(cloud.point_types[1], Ply_scalar_type::FLOAT64);
+  EXPECT_EQ(cloud.normal_types[1], Ply_scalar_type::FLOAT64);
+
+  // Missing the last byte of the edge element: truncated.
+  write_file(directory.file("cut.ply"), bytes.data.substr(0, bytes.data.size() - 1));
+  expect_io_error([&] { read_point_cloud(directory.file("cut.ply")); }, directory.file("cut.ply"),
+                  "truncated file");
+}
+
+TEST(Point_cloud_io, ply_every_scalar_type_in_both_endiannesses)
+{
+  Temporary_directory directory;
+  for(bool big_endian : {false, true}) {
+    Bytes bytes;
+    bytes.big_endian = big_endian;
+    bytes.data = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                 " 1.0\nelement vertex 2\n"
+                 "property int16 x\nproperty int32 y\nproperty int8 z\n"
+                 "property float32 nx\nproperty float64 ny\nproperty float nz\n"
+                 "property char a\nproperty uchar b\nproperty short c\nproperty ushort d\n"
+                 "property int e\nproperty uint f\nproperty float g\nproperty double h\nend_header\n";
+    bytes << std::int16_t(-300) << std::int32_t(-70000) << std::int8_t(-5) << 0.5f << 0.25 << -1.0f;
+    bytes << std::int8_t(-128) << std::uint8_t(255) << std::int16_t(-32768) << std::uint16_t(65535)
+          << std::int32_t(-2147483647 - 1) << std::uint32_t(4294967295u) << 1.1f << 1.1;
+    bytes << std::int16_t(32767) << std::int32_t(2147483647) << std::int8_t(127) << 0.f << 0.0 << 0.f;
+    bytes << std::int8_t(127) << std::uint8_t(0) << std::int16_t(32767) << std::uint16_t(0)
+          << std::int32_t(2147483647) << std::uint32_t(0) << -0.f << 1e-310;
+    const std::string filename = directory.file(big_endian ? "be.ply" : "le.ply");
+    write_file(filename, bytes.data);
+    const Point_cloud cloud = read_point_cloud(filename);
+    ASSERT_EQ(cloud.size(), 2u);
+    EXPECT_EQ(cloud.points[0], (std::array<double, 3>{{-300, -70000, -5}}));
+    EXPECT_EQ(cloud.normals[0], (std::array<double, 3>{{0.5, 0.25, -1}}));
+    EXPECT_EQ(cloud.points[1], (std::array<double, 3>{{32767, 2147483647, 127}}));
+    EXPECT_EQ(cloud.point_types[0], Ply_scalar_type::INT16);
+    EXPECT_EQ(cloud.point_types[1], Ply_scalar_type::INT32);
+    EXPECT_EQ(cloud.point_types[2], Ply_scalar_type::INT8);
+    EXPECT_EQ(cloud.normal_types[1], Ply_scalar_type::FLOAT64);
+    ASSERT_EQ(cloud.extra_properties.size(), 8u);
+    const std::vector<Ply_scalar_type> types = {Ply_scalar_type::INT8,   Ply_scalar_type::UINT8,
+                                                Ply_scalar_type::INT16,  Ply_scalar_type::UINT16,
+                                                Ply_scalar_type::INT32,  Ply_scalar_type::UINT32,
+                                                Ply_scalar_type::FLOAT32, Ply_scalar_type::FLOAT64};
+    for(std::size_t k = 0; k < types.size(); ++k) EXPECT_EQ(cloud.extra_properties[k].type, types[k]);
+    const std::vector<double> expected = {-128, 255, -32768, 65535, -2147483648.0, 4294967295.0,
+                                          static_cast<double>(1.1f), 1.1,
+                                          127, 0, 32767, 0, 2147483647, 0, -0.0, 1e-310};
+    EXPECT_EQ(cloud.extra_values, expected);
+    EXPECT_TRUE(std::signbit(cloud.extra_values[14]));
+
+    // Integer coordinates and float64 normals are written back with their types.
+    write_point_cloud(directory.file("out.ply"), cloud);
+    const Point_cloud again = read_point_cloud(directory.file("out.ply"));
+    expect_same_points(cloud, again);
+    expect_same_extras(cloud, again);
+    EXPECT_EQ(again.point_types, cloud.point_types);
+    EXPECT_EQ(again.normal_types, cloud.normal_types);
+  }
+}
+
+// --------------------------------------------------------------------------- ply writing
+
+TEST(Point_cloud_io, ply_extra_properties_round_trip)
+{
+  Temporary_directory directory;
+  Point_cloud cloud = sample_cloud(true);
+  add_extra_properties(cloud);
+  for(bool binary : {true, false}) {
+    Write_options options;
+    options.binary = binary;
+    const std::string first = directory.file(binary ? "first_binary.ply" : "first_ascii.ply");
+    const std::string second = directory.file(binary ? "second_binary.ply" : "second_ascii.ply");
+    write_point_cloud(first, cloud, options);
+    const Point_cloud read = read_point_cloud(first);
+    // Coordinates are doubles; normals are floats by default.
+    EXPECT_EQ(read.point_types[0], Ply_scalar_type::FLOAT64);
+    EXPECT_EQ(read.normal_types[0], Ply_scalar_type::FLOAT32);
+    ASSERT_EQ(read.size(), cloud.size());
+    for(std::size_t i = 0; i < cloud.size(); ++i) {
+      EXPECT_EQ(read.points[i], cloud.points[i]);
+      for(std::size_t c = 0; c < 3; ++c)
+        EXPECT_EQ(read.normals[i][c], static_cast<double>(static_cast<float>(cloud.normals[i][c])));
+    }
+    expect_same_extras(cloud, read);
+    // PLY -> Point_cloud -> PLY is stable, byte for byte.
+    write_point_cloud(second, read, options);
+    EXPECT_EQ(file_content(first), file_content(second));
+    expect_same_extras(read, read_point_cloud(second));
+  }
+  // The header lists x y z, nx ny nz, then the extra properties in order.
+  const std::string text = file_content(directory.file("first_ascii.ply"));
+  const std::string header = text.substr(0, text.find("end_header"));
+  EXPECT_NE(header.find("format ascii 1.0\ncomment generated by Normal_orientation\nelement vertex 51\n"
+                        "property double x\nproperty double y\nproperty double z\n"
+                        "property float nx\nproperty float ny\nproperty float nz\n"
+                        "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+                        "property int label\nproperty float quality\nproperty double density\n"
+                        "property char flag\nproperty uint id\nproperty short s\nproperty ushort u\n"),
+            std::string::npos)
+    << header;
+  EXPECT_NE(file_content(directory.file("first_binary.ply")).find("format binary_little_endian 1.0\n"),
+            std::string::npos);
+  EXPECT_FALSE(directory.has_temporary_file());
+}
+
+TEST(Point_cloud_io, ply_input_types_are_kept_on_output)
+{
+  Temporary_directory directory;
+  write_file(directory.file("in.ply"), "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
+                                       "property float y\nproperty float z\nproperty double nx\n"
+                                       "property double ny\nproperty double nz\nproperty uchar alpha\n"
+                                       "end_header\n0.1 0.2 0.3 0.6 0 0.8 7\n1 2 3 0 1 0 8\n");
+  Point_cloud cloud = read_point_cloud(directory.file("in.ply"));
+  cloud.normals[1] = {{0, -1, 0}}; // as the orientation would do
+  write_point_cloud(directory.file("out.ply"), cloud);
+  const std::string text = file_content(directory.file("out.ply"));
+  EXPECT_NE(text.find("property float x\nproperty float y\nproperty float z\nproperty double nx\n"
+                      "property double ny\nproperty double nz\nproperty uchar alpha\nend_header\n"),
+            std::string::npos);
+  // 2 vertices of 3 floats, 3 doubles, 1 uchar.
+  EXPECT_EQ(text.size() - (text.find("end_header\n") + 11), 2u * (12 + 24 + 1));
+  const Point_cloud read = read_point_cloud(directory.file("out.ply"));
+  expect_same_points(cloud, read);
+  expect_same_extras(cloud, read);
+
+  // Integer-typed normals are written as float.
+  Point_cloud integer_normals = cloud;
+  integer_normals.normal_types = {{Ply_scalar_type::INT8, Ply_scalar_type::INT8, Ply_scalar_type::INT8}};
+  integer_normals.normals[0] = {{0.6, 0, 0.8}};
+  write_point_cloud(directory.file("floats.ply"), integer_normals);
+  EXPECT_EQ(read_point_cloud(directory.file("floats.ply")).normal_types[0], Ply_scalar_type::FLOAT32);
+}
+
+TEST(Point_cloud_io, xyz_to_ply_and_back)
+{
+  Temporary_directory directory;
+  Write_options exact;
+  exact.precision = 0;
+  const Point_cloud cloud = sample_cloud(true);
+  write_point_cloud(directory.file("a.xyz"), cloud, exact);
+  const Point_cloud from_xyz = read_point_cloud(directory.file("a.xyz"));
+  write_point_cloud(directory.file("a.ply"), from_xyz);
+  const Point_cloud from_ply = read_point_cloud(directory.file("a.ply"));
+  ASSERT_EQ(from_ply.size(), cloud.size());
+  for(std::size_t i = 0; i < cloud.size(); ++i) EXPECT_EQ(from_ply.points[i], cloud.points[i]);
+  // Extra properties are dropped when writing .xyz.
+  Point_cloud with_extras = cloud;
+  add_extra_properties(with_extras);
+  write_point_cloud(directory.file("b.xyz"), with_extras, exact);
+  const Point_cloud b = read_point_cloud(directory.file("b.xyz"));
+  EXPECT_TRUE(b.extra_properties.empty());
+  expect_same_points(cloud, b);
+}
+
+// --------------------------------------------------------------------------- errors
+
+TEST(Point_cloud_io, missing_file_and_unknown_extension)
+{
+  Temporary_directory directory;
+  const std::string missing = directory.file("missing.xyz");
+  expect_io_error([&] { read_point_cloud(missing); }, missing, "cannot open file for reading");
+  const std::string missing_ply = directory.file("missing.ply");
+  expect_io_error([&] { read_point_cloud(missing_ply); }, missing_ply, "No such file");
+  const std::string text = directory.file("cloud.txt");
+  write_file(text, "1 2 3\n");
+  expect_io_error([&] { read_point_cloud(text); }, text, "unknown point cloud file extension '.txt'");
+  const std::string no_extension = directory.file("cloud");
+  write_file(no_extension, "1 2 3\n");
+  expect_io_error([&] { read_point_cloud(no_extension); }, no_extension, "unknown point cloud file extension");
+  expect_io_error([&] { write_point_cloud(directory.file("out.off"), sample_cloud(false)); },
+                  directory.file("out.off"), "unknown point cloud file extension '.off'");
+  fs::create_directory(directory.file("dir.xyz"));
+  expect_io_error([&] { read_point_cloud(directory.file("dir.xyz")); }, directory.file("dir.xyz"),
+                  "directory");
+  EXPECT_EQ(directory.listing(), (std::vector<std::string>{"cloud", "cloud.txt", "dir.xyz"}));
+}
+
+TEST(Point_cloud_io, xyz_errors)
+{
+  Temporary_directory directory;
+  expect_read_error(directory, "four.xyz", "1 2 3\n1 2 3 4\n", "wrong column count at line 2: 4 values");
+  expect_read_error(directory, "two.xyz", "# x y z\n1 2\n", "wrong column count at line 2: 2 values");
+  expect_read_error(directory, "seven.xyz", "1 2 3 4 5 6 7\n", "wrong column count at line 1: 7 values");
+  expect_read_error(directory, "mixed.xyz", "1 2 3\n\n1 2 3 0 0 1\n",
+                    "wrong column count at line 3: 6 values, but line 1 has 3");
+  expect_read_error(directory, "short.xyz", "1 2 3 0 0 1\n1 2 3 0 0", "wrong column count at line 2: 5 values");
+  expect_read_error(directory, "token.xyz", "1 2 3\n1 2 abc\n", "non-numeric token 'abc' at line 2");
+  expect_read_error(directory, "comma.xyz", "1,2,3\n", "non-numeric token '1,2,3' at line 1");
+  expect_read_error(directory, "sign.xyz", "1 2 ++3\n", "non-numeric token '++3' at line 1");
+  expect_read_error(directory, "trailing.xyz", "1 2 3 # comment\n", "non-numeric token '#' at line 1");
+  expect_read_error(directory, "nan.xyz", "1 2 3\n4 5 6\nnan 0 0\n", "non-finite coordinate at line 3");
+  expect_read_error(directory, "inf.xyz", "1 2 -inf\n", "non-finite coordinate at line 1");
+  expect_read_error(directory, "huge.xyz", "1 2 1e999\n", "out of range at line 1");
+  expect_read_error(directory, "normal.xyz", "1 2 3 0 0 1\n1 2 3 0 inf 1\n", "non-finite normal at line 2");
+}
+
+TEST(Point_cloud_io, ply_header_errors)
+{
+  Temporary_directory directory;
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  expect_read_error(directory, "magic.ply", "plyx\nformat ascii 1.0\n", "not a PLY file");
+  expect_read_error(directory, "format.ply", "ply\nformat text 1.0\nend_header\n", "bad PLY header at line 2");
+  expect_read_error(directory, "version.ply", "ply\nformat ascii 2.0\nend_header\n", "unsupported PLY version");
+  expect_read_error(directory, "no_format.ply", "ply\nelement vertex 0\n" + xyz + "end_header\n",
+                    "no 'format' line");
+  expect_read_error(directory, "no_end.ply", "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz,
+                    "no 'end_header' line");
+  expect_read_error(directory, "keyword.ply", "ply\nformat ascii 1.0\nelemnt vertex 0\nend_header\n",
+                    "bad PLY header at line 3: unknown keyword 'elemnt'");
+  expect_read_error(directory, "type.ply", "ply\nformat ascii 1.0\nelement vertex 0\nproperty real x\nend_header\n",
+                    "bad PLY header at line 4: unknown type 'real'");
+  expect_read_error(directory, "count.ply", "ply\nformat ascii 1.0\nelement vertex -1\n" + xyz + "end_header\n",
+                    "bad PLY header at line 3: invalid element count '-1'");
+  expect_read_error(directory, "orphan.ply", "ply\nformat ascii 1.0\nproperty float x\nend_header\n",
+                    "'property' before any 'element'");
+  expect_read_error(directory, "no_vertex.ply", "ply\nformat ascii 1.0\nelement face 0\nend_header\n",
+                    "no 'vertex' element");
+  expect_read_error(directory, "no_z.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nend_header\n",
+                    "element 'vertex' has no property 'z'");
+  expect_read_error(directory, "partial_normal.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz + "property float nx\nend_header\n",
+                    "all of 'nx ny nz' or none");
+  expect_read_error(directory, "duplicate.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz + "property float x\nend_header\n",
+                    "bad PLY header at line 7: second property 'x'");
+  expect_read_error(directory, "list.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz +
+                      "property list uchar int neighbours\nend_header\n",
+                    "list property 'neighbours' in element 'vertex' is not supported");
+  expect_read_error(directory, "float_count.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 0\n" + xyz +
+                      "element face 0\nproperty list float int vertex_indices\nend_header\n",
+                    "count type of a list must be an integer type");
+}
+
+TEST(Point_cloud_io, ply_data_errors)
+{
+  Temporary_directory directory;
+  const std::string ascii = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                            "property float z\nproperty uchar red\nend_header\n";
+  expect_read_error(directory, "truncated_ascii.ply", ascii + "1 2 3 4\n5 6 7 8\n",
+                    "truncated file: 3 vertices declared, data end at vertex 2");
+  expect_read_error(directory, "short_line.ply", ascii + "1 2 3 4\n5 6 7\n8 9 1 2\n",
+                    "short line: 3 values instead of 4 at line 10");
+  expect_read_error(directory, "long_line.ply", ascii + "1 2 3 4\n5 6 7 8 9\n8 9 1 2\n",
+                    "too many values: expected 4 at line 10");
+  expect_read_error(directory, "token.ply", ascii + "1 2 3 4\n5 six 7 8\n8 9 1 2\n",
+                    "non-numeric token 'six' at line 10");
+  expect_read_error(directory, "nan.ply", ascii + "1 2 3 4\n5 6 7 8\n8 NaN 1 2\n",
+                    "non-finite coordinate at line 11");
+  expect_read_error(directory, "colour.ply", ascii + "1 2 3 4\n5 6 7 256\n8 9 1 2\n",
+                    "value '256' out of range for property 'red' of type uchar at line 10");
+  expect_read_error(directory, "fraction.ply", ascii + "1 2 3 4\n5 6 7 2.5\n8 9 1 2\n", "out of range");
+  expect_read_error(directory, "truncated_face.ply",
+                    "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                    "1 2 3\n3 0 0 0\n",
+                    "truncated file: element 'face' declares 2 rows, data end at row 1");
+
+  // Binary: 3 vertices declared, 2.5 present.
+  Bytes bytes;
+  bytes.data = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+               "property float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n";
+  bytes << 1.f << 2.f << 3.f << 0.f << 0.f << 1.f;
+  bytes << 4.f << 5.f << 6.f << 0.f << 0.f << 0.f; // zero normal: allowed
+  const std::string good = bytes.data;
+  bytes << 7.f << 8.f << 9.f;
+  expect_read_error(directory, "truncated_binary.ply", bytes.data,
+                    "truncated file: 3 vertices declared, data end at vertex 2");
+  bytes << std::numeric_limits<float>::quiet_NaN() << 0.f << 0.f;
+  const std::string nan_normal = bytes.data;
+  expect_read_error(directory, "nan_normal.ply", nan_normal, "non-finite normal at vertex 2");
+  Bytes infinite;
+  infinite.data = good;
+  infinite << 7.f << std::numeric_limits<float>::infinity() << 9.f << 0.f << 0.f << 1.f;
+  expect_read_error(directory, "inf_binary.ply", infinite.data, "non-finite coordinate at vertex 2");
+  Bytes fine;
+  fine.data = good;
+  fine << 7.f << 8.f << 9.f << 0.f << 0.f << 1.f;
+  write_file(directory.file("fine.ply"), fine.data);
+  EXPECT_EQ(read_point_cloud(directory.file("fine.ply")).size(), 3u);
+}
+
+// --------------------------------------------------------------------------- atomic writing
+
+TEST(Point_cloud_io, write_to_missing_directory_throws_and_leaves_nothing)
+{
+  Temporary_directory directory;
+  const Point_cloud cloud = sample_cloud(true);
+  for(const char* name : {"no/such/dir/out.xyz", "no/such/dir/out.ply"}) {
+    const std::string filename = directory.file(name);
+    expect_io_error([&] { write_point_cloud(filename, cloud); }, filename, "cannot create temporary file");
+  }
+  EXPECT_TRUE(directory.listing().empty());
+}
+
+TEST(Point_cloud_io, failed_write_keeps_existing_file)
+{
+  Temporary_directory directory;
+  const std::string filename = directory.file("out.ply");
+  write_file(filename, "previous content");
+
+  // A value that does not fit its type is detected in the middle of the data.
+  Point_cloud cloud = sample_cloud(false);
+  add_extra_properties(cloud);
+  cloud.extra_values[40 * cloud.extra_properties.size()] = 256; // red of vertex 40
+  for(bool binary : {true, false}) {
+    Write_options options;
+    options.binary = binary;
+    expect_io_error([&] { write_point_cloud(filename, cloud, options); }, filename,
+                    "cannot write value 256 of property 'red' at vertex 40 as uchar");
+  }
+  // Inconsistent clouds.
+  Point_cloud bad_normals = sample_cloud(true);
+  bad_normals.normals.pop_back();
+  expect_io_error([&] { write_point_cloud(filename, bad_normals); }, filename, "normals for");
+  Point_cloud bad_extras = sample_cloud(false);
+  add_extra_properties(bad_extras);
+  bad_extras.extra_values.pop_back();
+  expect_io_error([&] { write_point_cloud(filename, bad_extras); }, filename, "extra values for");
+  Point_cloud reserved_name = sample_cloud(false);
+  reserved_name.extra_properties.push_back({"nx", Ply_scalar_type::FLOAT32});
+  reserved_name.extra_values.assign(reserved_name.size(), 0.0);
+  expect_io_error([&] { write_point_cloud(filename, reserved_name); }, filename, "extra property named 'nx'");
+  Point_cloud not_finite = sample_cloud(true);
+  not_finite.points[3][1] = std::numeric_limits<double>::quiet_NaN();
+  expect_io_error([&] { write_point_cloud(directory.file("out.xyz"), not_finite); }, directory.file("out.xyz"),
+                  "non-finite coordinate at vertex 3");
+
+  EXPECT_EQ(file_content(filename), "previous content");
+  EXPECT_EQ(directory.listing(), std::vector<std::string>{"out.ply"});
+
+  // A target that is a directory cannot be replaced.
+  fs::create_directory(directory.file("dir.ply"));
+  expect_io_error([&] { write_point_cloud(directory.file("dir.ply"), sample_cloud(false)); },
+                  directory.file("dir.ply"), "cannot rename");
+  EXPECT_EQ(directory.listing(), (std::vector<std::string>{"dir.ply", "out.ply"}));
+}
+
+TEST(Point_cloud_io, writing_never_leaves_temporary_files)
+{
+  Temporary_directory directory;
+  Point_cloud cloud = sample_cloud(true);
+  add_extra_properties(cloud);
+  Write_options ascii;
+  ascii.binary = false;
+  write_point_cloud(directory.file("a.xyz"), cloud);
+  write_point_cloud(directory.file("a.xyz"), cloud); // overwrite
+  write_point_cloud(directory.file("b.ply"), cloud);
+  write_point_cloud(directory.file("b.ply"), cloud, ascii);
+  write_point_cloud(directory.file("c.pwn"), cloud);
+  EXPECT_EQ(directory.listing(), (std::vector<std::string>{"a.xyz", "b.ply", "c.pwn"}));
+  EXPECT_NE(file_content(directory.file("b.ply")).find("format ascii 1.0"), std::string::npos);
+  EXPECT_FALSE(directory.has_temporary_file());
+}
