@@ -274,8 +274,9 @@ TEST(Mst_solver, WorksOnCsrGraphsWithBundledWeights)
     ASSERT_EQ(report.energy, 0.0);
     // an unbalanced start has a positive energy the solver removes
     std::vector<NO::Label> ones(n, 1);
-    if (NO::energy(g, get(&Csr_weight::weight, g), CGAL::make_property_map(ones)) > 0.0)
+    if (NO::energy(g, get(&Csr_weight::weight, g), CGAL::make_property_map(ones)) > 0.0) {
       ASSERT_GT(report.tree_edges, 0u);
+    }
   }
 }
 

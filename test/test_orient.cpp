@@ -226,9 +226,11 @@ TEST(Orient_normals, BadInputRaisesClearErrorsAndChangesNothing)
   bad = cloud;
   bad[7].second = Vector(std::numeric_limits<double>::infinity(), 0, 0);
   EXPECT_THROW(NO::orient_normals(bad, pn_params()), std::invalid_argument);
-  for (std::size_t i = 0; i < cloud.size(); ++i)
-    if (i != 7)
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    if (i != 7) {
       ASSERT_EQ(bad[i], cloud[i]);
+    }
+  }
 }
 
 TEST(Orient_normals, DegenerateCloudsAreHandled)

@@ -84,6 +84,9 @@ struct Outward_component_sign
   double band = 0.03;
   /// components smaller than this use the centroid rule
   std::size_t minimum_size_for_directions = 128;
+  /// larger components vote with an evenly spread subsample of about this
+  /// many points
+  std::size_t maximum_voters = 16384;
 
   /// the name used in reports
   static const char* name() { return "outward"; }
@@ -116,38 +119,52 @@ struct Outward_component_sign
       const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
       dir[t] = {s * std::cos(golden * t), s * std::sin(golden * t), z};
     }
+    // Flat copies of the points of large components (positions and
+    // current normals), so that the loops below stream through memory.
+    // A component of more than `maximum_voters` points votes with every
+    // s-th of its points, s = ceil(size / maximum_voters): the vote needs a
+    // dense sample of the extremal bands, not every point, and points
+    // arrive in a spatially coherent order (see `orient_normals()`), so the
+    // subsample is spread evenly.
+    std::vector<std::size_t> stride(nc, 1), seen(nc, 0);
+    for (std::size_t c = 0; c < nc; ++c)
+      stride[c] = std::max<std::size_t>(1, (size[c] + maximum_voters - 1) / std::max<std::size_t>(1, maximum_voters));
+    std::vector<std::uint32_t> cid;
+    std::vector<double> px, py, pz, nx, ny, nz;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t c = large_id[in.component[i]];
+      if (c == none)
+        continue;
+      if (seen[in.component[i]]++ % stride[in.component[i]] != 0)
+        continue;
+      cid.push_back(c);
+      px.push_back(coord(i, 0)); py.push_back(coord(i, 1)); pz.push_back(coord(i, 2));
+      nx.push_back(oriented(i, 0)); ny.push_back(oriented(i, 1)); nz.push_back(oriented(i, 2));
+    }
+    const std::size_t m = cid.size();
     std::vector<double> hi(nl * D, -HUGE_VAL), lo(nl * D, HUGE_VAL), num(nl * D, 0.0), den(nl * D, 0.0);
     if (nl > 0) {
       // Each direction is handled by one task over all points, so every
       // sum is accumulated in point order: deterministic for any thread
       // count.
       internal::parallel_chunks<CGAL::Parallel_if_available_tag>(D, [&](std::size_t b, std::size_t e) {
+        std::vector<double> proj(m);
         for (std::size_t t = b; t < e; ++t) {
-          for (std::size_t i = 0; i < n; ++i) {
-            const std::uint32_t c = large_id[in.component[i]];
-            if (c == none)
-              continue;
-            const double p = coord(i, 0) * dir[t][0] + coord(i, 1) * dir[t][1] + coord(i, 2) * dir[t][2];
-            const std::size_t s = std::size_t(c) * D + t;
+          const double dx = dir[t][0], dy = dir[t][1], dz = dir[t][2];
+          for (std::size_t i = 0; i < m; ++i) {
+            const double p = px[i] * dx + py[i] * dy + pz[i] * dz;
+            proj[i] = p;
+            const std::size_t s = std::size_t(cid[i]) * D + t;
             hi[s] = std::max(hi[s], p);
             lo[s] = std::min(lo[s], p);
           }
-          for (std::size_t i = 0; i < n; ++i) {
-            const std::uint32_t c = large_id[in.component[i]];
-            if (c == none)
-              continue;
-            const std::size_t s = std::size_t(c) * D + t;
-            const double p = coord(i, 0) * dir[t][0] + coord(i, 1) * dir[t][1] + coord(i, 2) * dir[t][2];
+          for (std::size_t i = 0; i < m; ++i) {
+            const std::size_t s = std::size_t(cid[i]) * D + t;
             const double depth = band * (hi[s] - lo[s]);
-            double w;
-            if (depth > 0.0)
-              w = 1.0 - (hi[s] - p) / depth;
-            else
-              w = (p >= hi[s]) ? 1.0 : 0.0;
+            const double w = depth > 0.0 ? 1.0 - (hi[s] - proj[i]) / depth : (proj[i] >= hi[s] ? 1.0 : 0.0);
             if (w <= 0.0)
               continue;
-            const double dn = oriented(i, 0) * dir[t][0] + oriented(i, 1) * dir[t][1] + oriented(i, 2) * dir[t][2];
-            num[s] += w * dn;
+            num[s] += w * (nx[i] * dx + ny[i] * dy + nz[i] * dz);
             den[s] += w;
           }
         }

@@ -7,6 +7,7 @@
 /// The signed union-find of the paper's supplement, section 2.
 
 #include <cstdint>
+#include <utility>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -72,6 +73,34 @@ public:
     return root;
   }
 
+  /// returns the root of `i` and stores the sign of `i` (`true` for -) in
+  /// `sign`, with one path compression
+  Index find(Index i, bool& sign)
+  {
+    const Index root = find(i);
+    sign = (root == i ? m_sign[i] : (m_sign[i] ^ m_sign[root])) != 0;
+    return root;
+  }
+
+  /// flips the sign of every element of the set whose root is `root`
+  /// \pre `root` is a root
+  void flip_root(Index root) { m_sign[root] ^= 1; }
+
+  /// merges the sets of the roots `a` and `b` without changing any sign;
+  /// returns the new root
+  /// \pre `a` and `b` are different roots
+  Index unite_roots(Index a, Index b)
+  {
+    if (m_rank[a] < m_rank[b] || (m_rank[a] == m_rank[b] && b < a))
+      std::swap(a, b);
+    // a becomes the root of b: b's subtree keeps its signs iff s_b ^= s_a
+    m_parent[b] = a;
+    m_sign[b] ^= m_sign[a];
+    if (m_rank[a] == m_rank[b])
+      ++m_rank[a];
+    return a;
+  }
+
   /// returns the sign of `i` (`true` for -), compressing its path
   bool sign(Index i)
   {
@@ -89,17 +118,8 @@ public:
   /// tie) without changing the sign of any element; returns the new root
   Index unite(Index i, Index j)
   {
-    Index a = find(i), b = find(j);
-    if (a == b)
-      return a;
-    if (m_rank[a] < m_rank[b] || (m_rank[a] == m_rank[b] && b < a))
-      std::swap(a, b);
-    // a becomes the root of b: b's subtree keeps its signs iff s_b ^= s_a
-    m_parent[b] = a;
-    m_sign[b] ^= m_sign[a];
-    if (m_rank[a] == m_rank[b])
-      ++m_rank[a];
-    return a;
+    const Index a = find(i), b = find(j);
+    return a == b ? a : unite_roots(a, b);
   }
 
 private:

@@ -40,7 +40,7 @@ namespace Normal_orientation {
 /// Wall-clock seconds of each stage of `orient_normals()`.
 struct Stage_seconds
 {
-  double input = 0.0;     ///< copying and checking the input
+  double input = 0.0;     ///< copying, checking and spatially sorting the input
   double neighbors = 0.0; ///< kd-tree and k-nearest-neighbour queries
   double graph = 0.0;     ///< edge weights and graph assembly
   double solve = 0.0;     ///< the solver
@@ -275,17 +275,42 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         constrained.push_back(get(cmap, *it) ? 1 : 0);
     }
   }
-  result.seconds.input = internal::seconds_since(t_start);
   if (n == 0) {
-    result.seconds.total = internal::seconds_since(t_start);
+    result.seconds.total = result.seconds.input = internal::seconds_since(t_start);
     return result;
   }
 
-  std::vector<Label> labels(n, Label(1));
+  std::vector<Label> input_labels(n, Label(1));
   try {
     internal::run_with_threads(threads, [&]() {
       const internal::Progress progress(callback);
       progress.report(0.0);
+
+      // Internally, points are numbered along a Morton curve: the kNN
+      // queries, the graph, the solver and the sign policy then walk memory
+      // in a spatially coherent order (random input orders cost several
+      // times more).  Ties are broken by input index, so this is
+      // deterministic; labels are mapped back to the input order at the end.
+      const std::vector<std::uint32_t> order = internal::morton_order<ConcurrencyTag>(pts);
+      {
+        std::vector<Point> sorted_pts(n);
+        std::vector<Vector> sorted_nrm(n);
+        internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+          for (std::size_t q = b; q < e; ++q) {
+            sorted_pts[q] = pts[order[q]];
+            sorted_nrm[q] = nrm[order[q]];
+          }
+        });
+        pts.swap(sorted_pts);
+        nrm.swap(sorted_nrm);
+        if (has_constraints) {
+          std::vector<char> sorted_constrained(n);
+          for (std::size_t q = 0; q < n; ++q)
+            sorted_constrained[q] = constrained[order[q]];
+          constrained.swap(sorted_constrained);
+        }
+      }
+      result.seconds.input = internal::seconds_since(t_start);
 
       // 2. Graph.
       Neighbor_graph graph;
@@ -298,6 +323,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       result.seconds.neighbors = gr.seconds_neighbors;
       result.seconds.graph = gr.seconds_graph;
       const auto weight = get(&Neighbor_edge::weight, graph);
+      std::vector<Label> labels(n, Label(1));
       const auto label_map = CGAL::make_property_map(labels);
       result.energy_before = energy(graph, weight, label_map);
 
@@ -319,6 +345,8 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         if (flip[component[i]])
           labels[i] = Label(-labels[i]);
       result.energy_after = energy(graph, weight, label_map);
+      for (std::size_t q = 0; q < n; ++q)
+        input_labels[order[q]] = labels[q];
       result.seconds.sign = internal::seconds_since(t);
       progress.report(1.0);
     });
@@ -333,10 +361,9 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
   {
     std::size_t i = 0;
     for (auto it = points.begin(); it != points.end(); ++it, ++i)
-      if (labels[i] < 0) {
+      if (input_labels[i] < 0) {
         put(normal_map, *it, -get(normal_map, *it));
-        if (nrm[i] != CGAL::NULL_VECTOR)
-          ++result.number_of_flipped;
+        ++result.number_of_flipped; // zero normals are never flipped: their edges weigh 0
       }
   }
   result.seconds.output = internal::seconds_since(t_out);

@@ -47,7 +47,7 @@ namespace Normal_orientation {
 /// (see `Component_sign.h`); vertices without edges get +1.
 ///
 /// Cost: O(E log E) for the sort (parallel with TBB), then O(E alpha(V)).
-/// Memory: about 17 bytes per edge and 6 bytes per vertex.
+/// Memory: about 16 bytes per edge and 7 bytes per vertex.
 /// \cgalModels `OrientationSolver`
 class Mst_solver
 {
@@ -65,22 +65,25 @@ public:
   Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
   {
     const auto start = std::chrono::steady_clock::now();
-    typedef typename boost::graph_traits<Graph>::vertex_descriptor vertex_descriptor;
     typedef typename boost::graph_traits<Graph>::edge_iterator edge_iterator;
     const std::size_t n = num_vertices(g);
     auto index = get(boost::vertex_index, g);
 
-    // 1. Gather the informative edges: ends, sign and a 64-bit sort key
-    //    (high word: complement of |w| as float bits, so that larger |w|
-    //    comes first; low word: position, which breaks ties).
-    std::vector<std::uint32_t> tail, head;
-    std::vector<std::uint64_t> keys;
-    std::vector<bool> negative;
-    const std::size_t m_all = std::size_t(num_edges(g));
-    tail.reserve(m_all);
-    head.reserve(m_all);
-    keys.reserve(m_all);
-    negative.reserve(m_all);
+    // 1. Gather the informative edges with a 64-bit sort key (high word:
+    //    complement of |w| as float bits, so that larger |w| comes first;
+    //    low word: position, which breaks ties).  The sign of w is kept in
+    //    the top bit of the head.  The ends travel with the key, so the
+    //    Kruskal loop below reads the edges sequentially.
+    const std::uint32_t negative_bit = 0x80000000u;
+    if (n >= std::size_t(negative_bit))
+      throw std::length_error("Mst_solver: more than 2^31 - 1 vertices");
+    struct Sorted_edge
+    {
+      std::uint64_t key;
+      std::uint32_t tail, head;
+    };
+    std::vector<Sorted_edge> sorted;
+    sorted.reserve(std::size_t(num_edges(g)));
     edge_iterator it, end;
     for (boost::tie(it, end) = edges(g); it != end; ++it) {
       const double w = double(get(weight, *it));
@@ -90,52 +93,53 @@ public:
       const std::size_t v = std::size_t(get(index, target(*it, g)));
       if (u == v)
         continue;
-      if (keys.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max()))
+      if (sorted.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max()))
         throw std::length_error("Mst_solver: more than 2^32 - 1 edges");
       float a = float(std::abs(w));
       std::uint32_t bits;
       std::memcpy(&bits, &a, sizeof bits);
-      keys.push_back((std::uint64_t(~bits) << 32) | std::uint64_t(keys.size()));
-      tail.push_back(std::uint32_t(u));
-      head.push_back(std::uint32_t(v));
-      negative.push_back(w < 0.0);
+      sorted.push_back({(std::uint64_t(~bits) << 32) | std::uint64_t(sorted.size()), std::uint32_t(u),
+                        std::uint32_t(v) | (w < 0.0 ? negative_bit : 0u)});
     }
 
     // 2. Sort by decreasing |w|; the keys are unique, so the order does not
     //    depend on the sort algorithm or the number of threads.
+    auto by_key = [](const Sorted_edge& a, const Sorted_edge& b) { return a.key < b.key; };
 #ifdef CGAL_LINKED_WITH_TBB
-    tbb::parallel_sort(keys.begin(), keys.end());
+    tbb::parallel_sort(sorted.begin(), sorted.end(), by_key);
 #else
-    std::sort(keys.begin(), keys.end());
+    std::sort(sorted.begin(), sorted.end(), by_key);
 #endif
 
     // 3. Kruskal with orientation propagation on the signed union-find.
     Signed_union_find uf(n);
     Solver_report report;
-    for (const std::uint64_t key : keys) {
-      const std::size_t e = std::size_t(key & 0xffffffffu);
-      const auto u = tail[e], v = head[e];
-      if (uf.same_set(u, v))
+    for (const Sorted_edge& e : sorted) {
+      const std::uint32_t u = e.tail, v = e.head & ~negative_bit;
+      bool su, sv;
+      const auto ru = uf.find(u, su), rv = uf.find(v, sv);
+      if (ru == rv)
         continue;
-      const bool different = uf.sign(u) != uf.sign(v);
-      if (different != bool(negative[e]))
-        uf.flip(v);
-      uf.unite(u, v);
+      if ((su != sv) != ((e.head & negative_bit) != 0))
+        uf.flip_root(rv);
+      uf.unite_roots(ru, rv);
       ++report.tree_edges;
     }
-    report.iterations = keys.size();
+    report.iterations = sorted.size();
 
-    // 4. Labels.
+    // 4. Labels, then energy and frustrated edges in one pass.
+    std::vector<Label> label(n);
+    for (std::size_t i = 0; i < n; ++i)
+      label[i] = Label(uf.sign(std::uint32_t(i)) ? -1 : 1);
     typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
-    for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit) {
-      const vertex_descriptor vd = *vit;
-      put(labels, vd, Label(uf.sign(std::uint32_t(get(index, vd))) ? -1 : 1));
+    for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit)
+      put(labels, *vit, label[std::size_t(get(index, *vit))]);
+    for (const Sorted_edge& e : sorted) {
+      const bool negative = (e.head & negative_bit) != 0;
+      if ((label[e.tail] == label[e.head & ~negative_bit]) == negative)
+        ++report.frustrated_edges;
     }
     report.energy = energy(g, weight, labels);
-    for (boost::tie(it, end) = edges(g); it != end; ++it)
-      if (edge_energy(double(get(weight, *it)), get(labels, source(*it, g)),
-                      get(labels, target(*it, g))) > 0.0)
-        ++report.frustrated_edges;
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;
   }
