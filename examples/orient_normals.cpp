@@ -79,7 +79,7 @@ struct Cloud_normal_map
 struct Options
 {
   std::string input, output;
-  unsigned int k = 10;
+  unsigned int k = NO::default_number_of_neighbors;
   double radius = 0.0;
   std::string criterion = "hoppe";
   std::string solver = "mst";
@@ -103,7 +103,7 @@ const char* usage_text =
   "Normals are estimated first when IN has none.\n"
   "\n"
   "options:\n"
-  "  --k N                neighbours per point (default 10)\n"
+  "  --k N                neighbours per point (default 12)\n"
   "  --radius R           neighbour radius (default: estimated from the data)\n"
   "  --criterion NAME     flip criterion: hoppe (default), xie, konig\n"
   "  --solver NAME        solver: mst (default)\n"

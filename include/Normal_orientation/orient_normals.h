@@ -152,7 +152,7 @@ void run_with_threads(int threads, const F& f)
 ///   \cgalParamNBegin{number_of_neighbors}
 ///     \cgalParamDescription{k of the k-nearest-neighbour graph (a `Normal_orientation::parameters` name)}
 ///     \cgalParamType{unsigned int, at least 1}
-///     \cgalParamDefault{`10`}
+///     \cgalParamDefault{`default_number_of_neighbors` (12)}
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{neighbor_radius}
 ///     \cgalParamDescription{the radius r: no edge is longer, and omega = 1 - d^2 / r^2}
@@ -213,7 +213,8 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
   const auto t_start = std::chrono::steady_clock::now();
   const Point_map point_map = NP_helper::get_point_map(points, np);
   const Normal_map normal_map = NP_helper::get_normal_map(points, np);
-  const unsigned int k = choose_parameter(get_parameter(np, internal_np::number_of_neighbors), 10u);
+  const unsigned int k = choose_parameter(get_parameter(np, internal_np::number_of_neighbors),
+                                          default_number_of_neighbors);
   const double radius = double(choose_parameter(get_parameter(np, CGAL::internal_np::neighbor_radius), 0.0));
   const int threads = int(choose_parameter(get_parameter(np, internal_np::number_of_threads), 0));
   const auto criterion = choose_parameter(get_parameter(np, internal_np::flip_criterion), Hoppe_criterion());

@@ -14,10 +14,6 @@
 #include <boost/graph/graph_traits.hpp>
 #include <boost/property_map/property_map.hpp>
 
-#ifdef CGAL_LINKED_WITH_TBB
-#include <tbb/parallel_sort.h>
-#endif
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -46,8 +42,8 @@ namespace Normal_orientation {
 /// of threads.  The global sign of every component is left as it comes
 /// (see `Component_sign.h`); vertices without edges get +1.
 ///
-/// Cost: O(E log E) for the sort (parallel with TBB), then O(E alpha(V)).
-/// Memory: about 16 bytes per edge and 7 bytes per vertex.
+/// Cost: O(E) for the sort (radix), then O(E alpha(V)).
+/// Memory: about 24 bytes per edge and 7 bytes per vertex during the solve.
 /// \cgalModels `OrientationSolver`
 class Mst_solver
 {
@@ -69,18 +65,17 @@ public:
     const std::size_t n = num_vertices(g);
     auto index = get(boost::vertex_index, g);
 
-    // 1. Gather the informative edges with a 64-bit sort key (high word:
-    //    complement of |w| as float bits, so that larger |w| comes first;
-    //    low word: position, which breaks ties).  The sign of w is kept in
-    //    the top bit of the head.  The ends travel with the key, so the
-    //    Kruskal loop below reads the edges sequentially.
+    // 1. Gather the informative edges with a 32-bit sort key: the
+    //    complement of |w| as float bits, so that larger |w| comes first.
+    //    The sign of w is kept in the top bit of the head.  The ends travel
+    //    with the key, so the Kruskal loop below reads the edges
+    //    sequentially.
     const std::uint32_t negative_bit = 0x80000000u;
     if (n >= std::size_t(negative_bit))
       throw std::length_error("Mst_solver: more than 2^31 - 1 vertices");
     struct Sorted_edge
     {
-      std::uint64_t key;
-      std::uint32_t tail, head;
+      std::uint32_t key, tail, head;
     };
     std::vector<Sorted_edge> sorted;
     sorted.reserve(std::size_t(num_edges(g)));
@@ -93,23 +88,33 @@ public:
       const std::size_t v = std::size_t(get(index, target(*it, g)));
       if (u == v)
         continue;
-      if (sorted.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max()))
-        throw std::length_error("Mst_solver: more than 2^32 - 1 edges");
       float a = float(std::abs(w));
       std::uint32_t bits;
       std::memcpy(&bits, &a, sizeof bits);
-      sorted.push_back({(std::uint64_t(~bits) << 32) | std::uint64_t(sorted.size()), std::uint32_t(u),
-                        std::uint32_t(v) | (w < 0.0 ? negative_bit : 0u)});
+      sorted.push_back({~bits, std::uint32_t(u), std::uint32_t(v) | (w < 0.0 ? negative_bit : 0u)});
     }
 
-    // 2. Sort by decreasing |w|; the keys are unique, so the order does not
-    //    depend on the sort algorithm or the number of threads.
-    auto by_key = [](const Sorted_edge& a, const Sorted_edge& b) { return a.key < b.key; };
-#ifdef CGAL_LINKED_WITH_TBB
-    tbb::parallel_sort(sorted.begin(), sorted.end(), by_key);
-#else
-    std::sort(sorted.begin(), sorted.end(), by_key);
-#endif
+    // 2. Sort by decreasing |w|, ties in the order of edges(g): a stable
+    //    least-significant-digit radix sort on the key, two 16-bit digits.
+    //    The order is fully determined, whatever the number of threads.
+    {
+      std::vector<Sorted_edge> buffer(sorted.size());
+      std::vector<std::size_t> start(std::size_t(1) << 16);
+      for (int shift = 0; shift < 32; shift += 16) {
+        std::fill(start.begin(), start.end(), std::size_t(0));
+        for (const Sorted_edge& e : sorted)
+          ++start[(e.key >> shift) & 0xffffu];
+        std::size_t sum = 0;
+        for (std::size_t& c : start) {
+          const std::size_t count = c;
+          c = sum;
+          sum += count;
+        }
+        for (const Sorted_edge& e : sorted)
+          buffer[start[(e.key >> shift) & 0xffffu]++] = e;
+        sorted.swap(buffer);
+      }
+    }
 
     // 3. Kruskal with orientation propagation on the signed union-find.
     Signed_union_find uf(n);
