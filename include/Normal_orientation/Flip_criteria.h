@@ -112,9 +112,16 @@ struct Xie_criterion
 /// cubic Hermite curves whose end tangents are perpendicular to the normals,
 /// once with the normals as given ("keep") and once with one of them flipped
 /// ("flip"); the curve that turns less wins.  phi = sign(c_flip - c_keep) *
-/// (1 - min(c_keep, c_flip) / max(c_keep, c_flip)), where c is the total
-/// turning angle of the best curve of each kind.  It assumes low curvature
-/// between neighbours and handles creases better than Hoppe's criterion.
+/// (1 - min(c_keep, c_flip) / max(c_keep, c_flip)) * l_i * l_j, where c is
+/// the total turning angle of the best curve of each kind, computed in the
+/// plane through p_i p_j that best contains the lines of both normals, and
+/// l_i, l_j are the lengths of the unit normals projected into that plane
+/// (1 when the edge and the normals are coplanar; the factor fades the
+/// criterion out where the planar construction means little).  It assumes
+/// low curvature between neighbours and handles creases better than
+/// Hoppe's criterion; like Hoppe's, it says "flip" across a slab thinner
+/// than the point spacing, where Xie's criterion is the one to use.
+/// See `internal::konig_phi()` for the construction and its guarantees.
 /// \cgalModels `FlipCriterion`
 struct Konig_criterion
 {
@@ -126,7 +133,7 @@ struct Konig_criterion
     const internal::Vec3 ni = internal::to_vec3(n_i), nj = internal::to_vec3(n_j);
     const double a[3] = {pi.x, pi.y, pi.z}, b[3] = {pj.x, pj.y, pj.z};
     const double na[3] = {ni.x, ni.y, ni.z}, nb[3] = {nj.x, nj.y, nj.z};
-    return internal::clamp_unit(internal::konig_phi(a, na, b, nb));
+    return internal::konig_phi(a, na, b, nb);
   }
   /// the name used on the command line and in reports
   static const char* name() { return "konig"; }
