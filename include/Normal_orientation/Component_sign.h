@@ -68,6 +68,9 @@ struct Keep_component_sign
 /// normals point along d; the witness's vote is the mean of d . n over
 /// those points, weighted by closeness to the extremal plane, a number in
 /// [-1, 1].  The component flips when the sum of the votes is negative.
+/// Components larger than `maximum_voters` vote with an evenly spread
+/// subsample of that size, which keeps the cost at O(n + 64 *
+/// maximum_voters) per component.
 /// Many witnesses, each averaging many points, keep one noisy normal at the
 /// topmost point (the peers' rule) from flipping a whole object.  Smaller
 /// components flip when the normals point on average towards their
