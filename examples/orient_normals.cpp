@@ -350,7 +350,9 @@ int main_impl(int argc, char** argv)
   const auto tw = std::chrono::steady_clock::now();
   NO::IO::Write_options wo;
   wo.binary = !o.ascii;
-  wo.precision = 0; // shortest text that reads back exactly: the output loses nothing
+  // The digits the input text had (or the shortest exact text): values read
+  // back from the output equal, bit for bit, those read from the input.
+  wo.precision = NO::IO::Write_options::PRECISION_AS_READ;
   NO::IO::write_point_cloud(o.output, cloud, wo);
   const double write_seconds = since(tw);
   const double total_seconds = since(t0);

@@ -19,6 +19,7 @@
 #include <functional>
 #include <iterator>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,7 @@ using Normal_orientation::IO::Io_error;
 using Normal_orientation::IO::Ply_property;
 using Normal_orientation::IO::Ply_scalar_type;
 using Normal_orientation::IO::Point_cloud;
+using Normal_orientation::IO::Read_options;
 using Normal_orientation::IO::Write_options;
 using Normal_orientation::IO::read_point_cloud;
 using Normal_orientation::IO::write_point_cloud;
@@ -185,6 +187,112 @@ void expect_same_points(const Point_cloud& a, const Point_cloud& b)
       EXPECT_EQ(a.normals[i], b.normals[i]) << "normal " << i;
     }
   }
+}
+
+/// \brief Bit pattern of `value`.
+std::uint64_t bits(double value)
+{
+  std::uint64_t result = 0;
+  std::memcpy(&result, &value, sizeof(result));
+  return result;
+}
+
+/// \brief Checks that `a` and `b` have the same points and normals, bit for bit (so
+/// that `0.0` and `-0.0` differ), and the same recorded digits.
+void expect_identical_clouds(const Point_cloud& a, const Point_cloud& b)
+{
+  ASSERT_EQ(a.points.size(), b.points.size());
+  ASSERT_EQ(a.normals.size(), b.normals.size());
+  EXPECT_EQ(a.point_digits, b.point_digits);
+  EXPECT_EQ(a.normal_digits, b.normal_digits);
+  std::size_t differences = 0;
+  for(std::size_t i = 0; i < a.points.size(); ++i)
+    for(std::size_t c = 0; c < 3; ++c) {
+      if(bits(a.points[i][c]) != bits(b.points[i][c]) && ++differences < 10)
+        ADD_FAILURE() << "point " << i << "[" << c << "]: " << a.points[i][c] << " vs " << b.points[i][c];
+      if(a.has_normals() && bits(a.normals[i][c]) != bits(b.normals[i][c]) && ++differences < 10)
+        ADD_FAILURE() << "normal " << i << "[" << c << "]: " << a.normals[i][c] << " vs " << b.normals[i][c];
+    }
+  EXPECT_EQ(differences, 0u);
+}
+
+/// \brief Text of a random decimal number with exactly `digits` significant digits as
+/// written (the first one non-zero, the others possibly zeros), in a random form:
+/// scientific, fixed with leading zeros, or integer, with a random sign; its decimal
+/// exponent lies in `[-max_exponent, max_exponent]`.
+std::string random_decimal(std::mt19937_64& random, int digits, int max_exponent = 30)
+{
+  std::string mantissa(1, static_cast<char>('1' + random() % 9));
+  for(int i = 1; i < digits; ++i)
+    mantissa += static_cast<char>('0' + (random() % 4 == 0 ? 0 : random() % 10)); // zeros are frequent
+  std::string text = random() % 2 == 0 ? "-" : "";
+  const int exponent = static_cast<int>(random() % (2 * max_exponent + 1)) - max_exponent; // of the first digit
+  switch(random() % 3) {
+  case 0: // d.ddde-12
+    text += mantissa.substr(0, 1);
+    if(digits > 1) text += "." + mantissa.substr(1);
+    text += (random() % 2 == 0 ? "e" : "E") + std::to_string(exponent);
+    break;
+  case 1: // 0.000ddd or ddd.ddd, if the exponent allows it
+    if(exponent < 0 && exponent >= -6) {
+      text += "0." + std::string(static_cast<std::size_t>(-exponent - 1), '0') + mantissa;
+    } else if(exponent >= 0 && exponent < digits - 1) {
+      text += mantissa.substr(0, static_cast<std::size_t>(exponent) + 1) + "." +
+              mantissa.substr(static_cast<std::size_t>(exponent) + 1);
+    } else {
+      text += mantissa + "e" + std::to_string(exponent - (digits - 1));
+    }
+    break;
+  default: // dddd (integer mantissa) and an exponent
+    const int integer_exponent = exponent - (digits - 1);
+    text += mantissa + (random() % 2 == 0 || integer_exponent < 0 ? "e" : "e+") + std::to_string(integer_exponent);
+    break;
+  }
+  return text;
+}
+
+/// \brief A large `.xyz` text (about `lines * 75` bytes) with normals, comments, blank
+/// lines, CRLF line ends, tabs and various number forms.
+std::string large_xyz_text(std::size_t lines)
+{
+  std::mt19937_64 random(42);
+  std::string text;
+  text.reserve(lines * 80);
+  for(std::size_t line = 1; line <= lines; ++line) {
+    if(line % 997 == 0) {
+      text += "# comment line " + std::to_string(line) + "\n";
+      continue;
+    }
+    if(line % 1009 == 0) {
+      text += " \t \n";
+      continue;
+    }
+    for(int c = 0; c < 6; ++c) {
+      if(c != 0) text += (line % 7 == 0) ? "\t" : " ";
+      text += random_decimal(random, 1 + static_cast<int>(random() % 9), 3);
+    }
+    text += (line % 11 == 0) ? "\r\n" : "\n";
+  }
+  return text;
+}
+
+/// \brief Message of the `Io_error` thrown by `action`, or `"no error"`.
+std::string error_message(const std::function<void()>& action)
+{
+  try {
+    action();
+  } catch(const Io_error& error) {
+    return error.what();
+  }
+  return "no error";
+}
+
+/// \brief Reads `filename` with `threads` threads.
+Point_cloud read_with_threads(const std::string& filename, unsigned int threads)
+{
+  Read_options options;
+  options.number_of_threads = threads;
+  return read_point_cloud(filename, options);
 }
 
 void expect_same_extras(const Point_cloud& a, const Point_cloud& b)
@@ -348,6 +456,351 @@ TEST(Point_cloud_io, empty_files)
   EXPECT_EQ(read_point_cloud(directory.file("f.ply")).size(), 0u);
   EXPECT_EQ(read_point_cloud(directory.file("f.xyz")).size(), 0u);
   EXPECT_EQ(file_content(directory.file("f.xyz")), "");
+}
+
+// --------------------------------------------------------------------------- precision as read
+
+TEST(Point_cloud_io, significant_digits_of_tokens)
+{
+  using Normal_orientation::IO::internal::significant_digits;
+  const std::vector<std::pair<std::string, int>> cases = {
+    {"0.012345", 5}, {"1.2300e5", 5}, {"-0", 1},         {"0", 1},        {"0.000", 1},
+    {"+12.5", 3},    {"0012", 2},     {"100", 3},        {"-1.5E-07", 2}, {".5", 1},
+    {"1.", 1},       {"-.0", 1},      {"0e5", 1},        {"5e-324", 1},   {"1.000000", 7},
+    {"0.1000", 4},   {"-0.00606638857", 9}, {"123456789012345678", 18}, {"9.99e+300", 3},
+    {"12.34e-5", 4}, {"000.000120", 3}, {"7E0", 1}};
+  for(const std::pair<std::string, int>& c : cases)
+    EXPECT_EQ(significant_digits(c.first.data(), c.first.data() + c.first.size()), c.second) << c.first;
+
+  // Reading records the largest counts, separately for coordinates and normals.
+  Temporary_directory directory;
+  write_file(directory.file("a.xyz"), "# 1.23456789012 comments do not count\n"
+                                      "1.5 -0.25 3 0.5 0.25 -0.125\n"
+                                      "\n"
+                                      "0.012345 1 2 1 0 -0\n"
+                                      "1e5 -2.50E+3 7 0.1 0.20 0.3\n");
+  const Point_cloud cloud = read_point_cloud(directory.file("a.xyz"));
+  EXPECT_EQ(cloud.point_digits, 5);
+  EXPECT_EQ(cloud.normal_digits, 3);
+  write_file(directory.file("b.xyz"), "0.5 1 2\n3 4 5.0000000000000001\n");
+  const Point_cloud no_normals = read_point_cloud(directory.file("b.xyz"));
+  EXPECT_EQ(no_normals.point_digits, 17);
+  EXPECT_EQ(no_normals.normal_digits, 0);
+  // Digits increasing along the file, in various forms: every token is counted.
+  const std::vector<std::string> forms = {"0.", "-0.", "-0.0", "+0.00", "", "-", "1.", "-1.", "2e3 ", "0.0e"};
+  for(const std::string& form : forms) {
+    std::string text;
+    std::string digits;
+    for(int count = 1; count <= 15; ++count) {
+      digits += static_cast<char>('1' + count % 9);
+      const std::string token = form == "2e3 "   ? digits + "e3"
+                                : form == "0.0e" ? "0.0" + digits + "e-7"
+                                                 : form + digits;
+      text += (count % 3 == 1 ? "" : " ") + token + (count % 3 == 0 ? "\n" : "");
+      write_file(directory.file("d.xyz"), text + (count % 3 == 0 ? "" : count % 3 == 1 ? " 0 0\n" : " 0\n"));
+      const int expected = form == "1." || form == "-1." ? count + 1 : count;
+      EXPECT_EQ(read_point_cloud(directory.file("d.xyz")).point_digits, expected) << text;
+    }
+  }
+  write_file(directory.file("c.xyz"), "# nothing\n");
+  EXPECT_EQ(read_point_cloud(directory.file("c.xyz")).point_digits, 0);
+  // Unknown for PLY and in-memory clouds.
+  write_point_cloud(directory.file("d.ply"), cloud);
+  const Point_cloud from_ply = read_point_cloud(directory.file("d.ply"));
+  EXPECT_EQ(from_ply.point_digits, 0);
+  EXPECT_EQ(from_ply.normal_digits, 0);
+  EXPECT_EQ(Point_cloud().point_digits, 0);
+}
+
+TEST(Point_cloud_io, as_read_reproduces_the_values_bit_for_bit)
+{
+  Temporary_directory directory;
+  std::mt19937_64 random(7);
+  for(int point_digits = 1; point_digits <= 15; ++point_digits) {
+    const int normal_digits = 16 - point_digits; // points and normals differ
+    std::string text;
+    for(int line = 0; line < 400; ++line) {
+      for(int c = 0; c < 3; ++c) text += random_decimal(random, 1 + static_cast<int>(random() % point_digits)) + " ";
+      for(int c = 0; c < 3; ++c)
+        text += random_decimal(random, 1 + static_cast<int>(random() % normal_digits), 3) + " ";
+      text += "\n";
+    }
+    // Extreme magnitudes (subnormal, largest, smallest normal) with the digits allowed.
+    auto extremes = [](int digits) -> std::string {
+      if(digits >= 14) return "4.9406564584125e-324 -1.7976931348623e308 2.2250738585072e-308";
+      if(digits >= 2) return "-2.5e-324 1.7e308 -2.2e-308";
+      return "5e-324 -1e308 2e-308";
+    };
+    text += extremes(point_digits) + " " + extremes(normal_digits) + "\n";
+    // The largest counts are reached.
+    text += "-0 0.000 1" + std::string(static_cast<std::size_t>(point_digits - 1), '0') + " " +
+            (normal_digits >= 2 ? "-1.5e-310 " : "-1e-310 ") + random_decimal(random, normal_digits, 300) + " -0\n";
+    const std::string input = directory.file("in.xyz");
+    write_file(input, text);
+    Point_cloud cloud = read_point_cloud(input);
+    ASSERT_EQ(cloud.point_digits, point_digits);
+    ASSERT_EQ(cloud.normal_digits, normal_digits);
+    // Flip some normals: their signs change, not their digit counts.
+    for(std::size_t i = 0; i < cloud.size(); i += 3)
+      for(double& v : cloud.normals[i]) v = -v;
+
+    Write_options as_read;
+    as_read.precision = Write_options::PRECISION_AS_READ;
+    const std::string output = directory.file("out.xyz");
+    write_point_cloud(output, cloud, as_read);
+    const Point_cloud back = read_point_cloud(output);
+    ASSERT_EQ(back.size(), cloud.size());
+    std::size_t differences = 0;
+    for(std::size_t i = 0; i < cloud.size(); ++i)
+      for(std::size_t c = 0; c < 3; ++c) {
+        differences += bits(back.points[i][c]) != bits(cloud.points[i][c]);
+        differences += bits(back.normals[i][c]) != bits(cloud.normals[i][c]);
+      }
+    EXPECT_EQ(differences, 0u) << point_digits << " digits";
+    // No more digits than read.
+    EXPECT_LE(back.point_digits, point_digits);
+    EXPECT_LE(back.normal_digits, normal_digits);
+    // Any negative precision means "as read".
+    Write_options minus_two;
+    minus_two.precision = -2;
+    write_point_cloud(directory.file("out2.xyz"), cloud, minus_two);
+    EXPECT_EQ(file_content(directory.file("out2.xyz")), file_content(output));
+  }
+}
+
+TEST(Point_cloud_io, as_read_writes_like_printf_with_the_digits_read)
+{
+  Temporary_directory directory;
+  write_file(directory.file("in.xyz"), "0.149716222 -0.487264655 0.213049765 0.00606638857 0.998976844 -0.0448158807\n"
+                                       "1.50 2 3 0.5 -0.25 1e3\n");
+  Point_cloud cloud = read_point_cloud(directory.file("in.xyz"));
+  ASSERT_EQ(cloud.point_digits, 9);
+  ASSERT_EQ(cloud.normal_digits, 9);
+  cloud.normals[1] = {{-0.5, 0.25, -1000.0}};
+  Write_options as_read;
+  as_read.precision = Write_options::PRECISION_AS_READ;
+  write_point_cloud(directory.file("out.xyz"), cloud, as_read);
+  EXPECT_EQ(file_content(directory.file("out.xyz")),
+            "0.149716222 -0.487264655 0.213049765 0.00606638857 0.998976844 -0.0448158807\n"
+            "1.5 2 3 -0.5 0.25 -1000\n");
+  // Different precisions for points and normals.
+  cloud.point_digits = 2;
+  cloud.normal_digits = 4;
+  write_point_cloud(directory.file("out.xyz"), cloud, as_read);
+  EXPECT_EQ(file_content(directory.file("out.xyz")), "0.15 -0.49 0.21 0.006066 0.999 -0.04482\n"
+                                                       "1.5 2 3 -0.5 0.25 -1000\n");
+  // A positive precision or PRECISION_SHORTEST ignores the digits read.
+  write_point_cloud(directory.file("out.xyz"), cloud, Write_options{true, 3});
+  EXPECT_EQ(file_content(directory.file("out.xyz")).substr(0, 16), "0.15 -0.487 0.21");
+}
+
+TEST(Point_cloud_io, as_read_falls_back_to_shortest_when_digits_are_unknown_or_above_15)
+{
+  Temporary_directory directory;
+  Write_options as_read;
+  as_read.precision = Write_options::PRECISION_AS_READ;
+  Write_options shortest;
+  shortest.precision = Write_options::PRECISION_SHORTEST;
+  // 16 and 17 digits: a %.16g round trip is not always exact, the shortest text is.
+  write_file(directory.file("in.xyz"), "0.1000000000000001 9007199254740993 0.3 "
+                                       "0.30000000000000004 -1 2.2250738585072014e-308\n"
+                                       "1.7976931348623157e308 4.9406564584124654e-324 1 0 0 1\n");
+  Point_cloud cloud = read_point_cloud(directory.file("in.xyz"));
+  EXPECT_EQ(cloud.point_digits, 17);
+  EXPECT_EQ(cloud.normal_digits, 17);
+  for(int point_digits : {16, 17, 25, 0}) {
+    cloud.point_digits = point_digits;
+    cloud.normal_digits = point_digits == 0 ? 0 : 16;
+    write_point_cloud(directory.file("as_read.xyz"), cloud, as_read);
+    write_point_cloud(directory.file("shortest.xyz"), cloud, shortest);
+    EXPECT_EQ(file_content(directory.file("as_read.xyz")), file_content(directory.file("shortest.xyz")))
+      << point_digits;
+    Point_cloud back = read_point_cloud(directory.file("as_read.xyz"));
+    back.point_digits = cloud.point_digits;
+    back.normal_digits = cloud.normal_digits;
+    expect_identical_clouds(cloud, back);
+  }
+  // A cloud built in memory (digits unknown) is written exactly.
+  const Point_cloud memory = sample_cloud(true);
+  write_point_cloud(directory.file("as_read.xyz"), memory, as_read);
+  write_point_cloud(directory.file("shortest.xyz"), memory, shortest);
+  EXPECT_EQ(file_content(directory.file("as_read.xyz")), file_content(directory.file("shortest.xyz")));
+  // Only the normals known: the points are written shortest.
+  cloud.point_digits = 0;
+  cloud.normal_digits = 1;
+  write_point_cloud(directory.file("as_read.xyz"), cloud, as_read);
+  const std::string text = file_content(directory.file("as_read.xyz"));
+  EXPECT_EQ(text.substr(text.find('\n') + 1), "1.7976931348623157e+308 5e-324 1 0 0 1\n");
+}
+
+// --------------------------------------------------------------------------- parallel text
+
+TEST(Point_cloud_io, parallel_reading_gives_the_sequential_cloud)
+{
+  Temporary_directory directory;
+  const std::string filename = directory.file("large.xyz");
+  const std::size_t lines = 100000;
+  write_file(filename, large_xyz_text(lines));
+  ASSERT_GT(fs::file_size(filename), std::uintmax_t(5) << 20); // more than the 4 MB threshold
+  const Point_cloud sequential = read_with_threads(filename, 1);
+  EXPECT_EQ(sequential.size(), lines - lines / 997 - lines / 1009 + lines / (997 * 1009));
+  EXPECT_EQ(sequential.point_digits, 9);
+  EXPECT_EQ(sequential.normal_digits, 9);
+  for(unsigned int threads : {2u, 3u, 5u, 8u, 0u, 100u}) {
+    SCOPED_TRACE(threads);
+    expect_identical_clouds(sequential, read_with_threads(filename, threads));
+  }
+  expect_identical_clouds(sequential, read_point_cloud(filename)); // default options
+
+  // Small files split at every possible place: more threads than lines, empty chunks,
+  // comments, blank lines and a missing final newline.
+  const std::string small = "# head\n1 2 3 4 5 6\n\n  7 8 9.125 0 0 1\r\n# c\n-1 -2 -3 0.5 0.5 0.5\n\t\n4 5 6 7 8 9";
+  for(std::size_t length = 0; length <= small.size(); ++length) {
+    write_file(directory.file("small.xyz"), small.substr(0, length));
+    std::string expected_message;
+    Point_cloud expected;
+    try {
+      expected = read_with_threads(directory.file("small.xyz"), 1);
+    } catch(const Io_error& error) {
+      expected_message = error.what();
+    }
+    for(unsigned int threads = 2; threads <= 8; ++threads) {
+      SCOPED_TRACE("length " + std::to_string(length) + ", threads " + std::to_string(threads));
+      if(expected_message.empty())
+        expect_identical_clouds(expected, read_with_threads(directory.file("small.xyz"), threads));
+      else
+        EXPECT_EQ(error_message([&] { read_with_threads(directory.file("small.xyz"), threads); }), expected_message);
+    }
+  }
+}
+
+TEST(Point_cloud_io, parallel_writing_gives_the_sequential_file)
+{
+  Temporary_directory directory;
+  write_file(directory.file("large.xyz"), large_xyz_text(100000));
+  Point_cloud cloud = read_point_cloud(directory.file("large.xyz"));
+  for(std::size_t i = 0; i < cloud.size(); i += 5)
+    for(double& v : cloud.normals[i]) v = -v;
+  Point_cloud no_normals = cloud;
+  no_normals.normals.clear();
+  for(const Point_cloud* written : {&cloud, &no_normals})
+    for(int precision : {Write_options::PRECISION_AS_READ, Write_options::PRECISION_SHORTEST, 4}) {
+      SCOPED_TRACE("precision " + std::to_string(precision));
+      Write_options options;
+      options.precision = precision;
+      options.number_of_threads = 1;
+      write_point_cloud(directory.file("sequential.xyz"), *written, options);
+      const std::string expected = file_content(directory.file("sequential.xyz"));
+      EXPECT_GT(expected.size(), std::size_t(1) << 20);
+      for(unsigned int threads : {2u, 3u, 8u}) {
+        options.number_of_threads = threads;
+        write_point_cloud(directory.file("parallel.xyz"), *written, options);
+        EXPECT_TRUE(file_content(directory.file("parallel.xyz")) == expected) << threads << " threads";
+      }
+      if(precision == Write_options::PRECISION_AS_READ) {
+        Point_cloud back = read_point_cloud(directory.file("parallel.xyz"));
+        back.point_digits = written->point_digits;
+        back.normal_digits = written->normal_digits;
+        expect_identical_clouds(*written, back);
+      }
+    }
+  EXPECT_FALSE(directory.has_temporary_file());
+
+  // Small clouds with many threads (fewer blocks than threads).
+  const Point_cloud small = sample_cloud(true);
+  Write_options options;
+  options.number_of_threads = 1;
+  write_point_cloud(directory.file("s1.xyz"), small, options);
+  options.number_of_threads = 8;
+  write_point_cloud(directory.file("s8.xyz"), small, options);
+  EXPECT_EQ(file_content(directory.file("s1.xyz")), file_content(directory.file("s8.xyz")));
+  write_point_cloud(directory.file("empty.xyz"), Point_cloud(), options);
+  EXPECT_EQ(file_content(directory.file("empty.xyz")), "");
+}
+
+TEST(Point_cloud_io, parallel_reading_reports_the_first_error_with_its_line)
+{
+  Temporary_directory directory;
+  const std::size_t lines = 100000;
+  const std::string text = large_xyz_text(lines);
+  std::vector<std::size_t> line_starts(1, 0);
+  for(std::size_t i = 0; i < text.size(); ++i)
+    if(text[i] == '\n') line_starts.push_back(i + 1);
+  ASSERT_EQ(line_starts.size(), lines + 1);
+  // `text` with line `line` (1-based, a data line) replaced by `replacement`.
+  auto with_line = [&](const std::string& base, std::size_t line, const std::string& replacement) {
+    const std::size_t begin = line_starts[line - 1];
+    const std::size_t end = base.find('\n', begin);
+    return base.substr(0, begin) + replacement + base.substr(end);
+  };
+  const std::string broken_late = with_line(text, 80000, "1 2 3 0 0 nan");
+  struct Case
+  {
+    std::string name;
+    std::string content;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+    {"token", with_line(text, 70001, "1 2 3 0 zero 1"), "non-numeric token 'zero' at line 70001"},
+    {"range", with_line(text, 66000, "1 2 3 0 1e999 1"), "number '1e999' out of range at line 66000"},
+    {"count", with_line(text, 88888, "1 2 3 0"), "wrong column count at line 88888: 4 values, expected 3"},
+    {"mismatch", with_line(text, 50001, "1 2 3"), "wrong column count at line 50001: 3 values, but line 1 has 6"},
+    {"coordinate", with_line(text, 89999, "inf 2 3 0 0 1"), "non-finite coordinate at line 89999"},
+    {"normal", broken_late, "non-finite normal at line 80000"},
+    {"last", with_line(text, 100000, "1 2 3 0 0"), "wrong column count at line 100000: 5 values"},
+    // Two errors: the first one in the file wins, whatever the chunks.
+    {"two", with_line(broken_late, 46000, "x 2 3 0 0 1"), "non-numeric token 'x' at line 46000"},
+    {"two_late", with_line(broken_late, 85000, "x"), "non-finite normal at line 80000"},
+    // From line 60000 on, three columns: the mismatch is at line 60000 whatever the
+    // chunk holding it, even with another error after it in the same chunk.
+    {"columns", [&] {
+       std::string three = text.substr(0, line_starts[59999]);
+       for(std::size_t line = 60000; line <= lines; ++line) three += line == 70000 ? "1 2 z\n" : "1 2 3\n";
+       return three;
+     }(),
+     "wrong column count at line 60000: 3 values, but line 1 has 6"},
+  };
+  for(const Case& c : cases) {
+    const std::string filename = directory.file(c.name + ".xyz");
+    write_file(filename, c.content);
+    for(unsigned int threads : {1u, 2u, 7u, 0u}) {
+      SCOPED_TRACE(c.name + ", threads " + std::to_string(threads));
+      expect_io_error([&] { read_with_threads(filename, threads); }, filename, c.expected);
+    }
+  }
+
+  // In a small file, every error position and every split give the sequential message.
+  const std::vector<std::string> good = {"1 2 3 0 0 1", "# comment", "", "4 5 6 1 0 0", "7 8 9 0 1 0",
+                                         "\t", "1.5 2.5 3.5 0 0 1", "9 9 9 1 1 1"};
+  const std::vector<std::string> bad = {"1 2 x 0 0 1", "1 2 3", "1 2 3 4", "nan 0 0 0 0 1", "0 0 0 0 0 inf",
+                                        "1e400 0 0 0 0 0", "1 2 3 4 5 6 7"};
+  for(std::size_t position = 0; position < good.size(); ++position)
+    for(const std::string& error : bad) {
+      std::string content;
+      for(std::size_t line = 0; line < good.size(); ++line)
+        content += (line == position ? error : good[line]) + "\n";
+      if(position + 2 < good.size()) content += error + " trailing\n"; // a second error
+      const std::string filename = directory.file("small.xyz");
+      write_file(filename, content);
+      const std::string expected = error_message([&] { read_with_threads(filename, 1); });
+      EXPECT_NE(expected.find("at line"), std::string::npos) << expected;
+      for(unsigned int threads = 2; threads <= 8; ++threads)
+        EXPECT_EQ(error_message([&] { read_with_threads(filename, threads); }), expected)
+          << "error '" << error << "' at line " << position + 1 << ", threads " << threads;
+    }
+}
+
+TEST(Point_cloud_io, read_and_write_options_keep_their_aggregate_form)
+{
+  const Write_options legacy{false, 12};
+  EXPECT_FALSE(legacy.binary);
+  EXPECT_EQ(legacy.precision, 12);
+  EXPECT_EQ(legacy.number_of_threads, 0u);
+  EXPECT_EQ(Write_options().precision, 9);
+  const Read_options automatic{};
+  EXPECT_EQ(automatic.number_of_threads, 0u);
+  EXPECT_EQ(Write_options::PRECISION_AS_READ, -1);
+  EXPECT_EQ(Write_options::PRECISION_SHORTEST, 0);
 }
 
 // --------------------------------------------------------------------------- ply reading

@@ -7,7 +7,14 @@
 /// files). Whole files are read with a single `fread`, text is parsed with
 /// `std::from_chars` and written with `std::to_chars` (or an exact, faster equivalent for
 /// a fixed number of digits), so that clouds of millions of points are read and written
-/// in a fraction of a second.
+/// in a fraction of a second. Large `.xyz`/`.pwn` files are parsed and formatted by
+/// several `std::thread`s (see `Read_options` and `Write_options`); the result is the
+/// same as with one thread, byte for byte and error message for error message.
+///
+/// Reading a `.xyz`/`.pwn` file records how many significant digits its numbers have
+/// (`Point_cloud::point_digits`, `Point_cloud::normal_digits`), so that the cloud can be
+/// written back with no more digits than it was read with and still lose nothing
+/// (`Write_options::PRECISION_AS_READ`).
 ///
 /// Reading keeps, for a PLY input, every vertex property other than `x y z nx ny nz`
 /// (for instance colours), so that they can be written back unchanged to a PLY output.
@@ -29,18 +36,22 @@
 #include <cfloat>
 #include <charconv>
 #include <cmath>
+#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <limits>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
 #include <system_error>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -157,6 +168,18 @@ struct Point_cloud
   /// `FLOAT32` as they cannot hold unit normals.
   std::array<Ply_scalar_type, 3> normal_types{
     {Ply_scalar_type::FLOAT32, Ply_scalar_type::FLOAT32, Ply_scalar_type::FLOAT32}};
+  /// Largest number of significant decimal digits of a coordinate of a `.xyz`/`.pwn`
+  /// input, counted as written: leading zeros are not counted, the other digits of the
+  /// mantissa are, trailing zeros included, and the exponent is not (`0.012345` has 5,
+  /// `1.2300e5` has 5, `-0` and `0.000` have 1). 0 means unknown: PLY input, text input
+  /// without data lines, or cloud built in memory. Used by
+  /// `Write_options::PRECISION_AS_READ`; a caller that replaces coordinates by computed
+  /// values must reset it to 0.
+  int point_digits = 0;
+  /// Same as `point_digits` for the components of the normals; 0 when unknown or when
+  /// the input has no normals. A caller that replaces normals by computed values (other
+  /// than by negating them) must reset it to 0.
+  int normal_digits = 0;
 
   /// \brief Returns `true` if the cloud has normals (`normals` is not empty).
   bool has_normals() const { return !normals.empty(); }
@@ -164,16 +187,57 @@ struct Point_cloud
   std::size_t size() const { return points.size(); }
 };
 
+/// \brief Options of `read_point_cloud()`.
+struct Read_options
+{
+  /// `.xyz`/`.pwn` only: number of threads parsing the text. 0 chooses automatically:
+  /// one thread for a file of at most 4 MB, otherwise `std::thread::hardware_concurrency()`
+  /// threads, at most 8. A positive value is used whatever the file size, at most 8.
+  /// The file is split at line boundaries into one chunk per thread; the cloud read, and
+  /// the message of the first error in file order, do not depend on the number of threads.
+  unsigned int number_of_threads = 0;
+};
+
 /// \brief Options of `write_point_cloud()`.
 struct Write_options
 {
+  /// Value of `precision` that writes each value with the shortest text that reads back
+  /// to the exact same `double`.
+  static constexpr int PRECISION_SHORTEST = 0;
+  /// Value of `precision` (any negative value does the same) that writes the values
+  /// with as many significant digits as the `.xyz`/`.pwn` input had, when that is
+  /// known to be lossless, and with `PRECISION_SHORTEST` otherwise. See `precision`.
+  static constexpr int PRECISION_AS_READ = -1;
+
   /// PLY only: write `binary_little_endian` if `true`, `ascii` otherwise.
   bool binary = true;
-  /// `.xyz`/`.pwn` only: number of significant digits of each value (`%g` style, at
-  /// most 17 are used). A value `<= 0` writes the shortest text that reads back to the
-  /// exact same `double`. An ASCII PLY file is always written with the shortest exact
-  /// representation of each value in its declared type, so that it round-trips.
+  /// `.xyz`/`.pwn` only: how many significant digits each value is written with.
+  /// - A positive value: that many significant digits (`%g` style, at most 17 are used).
+  /// - `PRECISION_SHORTEST` (0): the shortest text that reads back to the exact same
+  ///   `double`.
+  /// - `PRECISION_AS_READ` (any negative value): the coordinates with
+  ///   `Point_cloud::point_digits` significant digits (`%g` style) if it lies in
+  ///   `[1, 15]`, with `PRECISION_SHORTEST` otherwise (unknown, i.e. 0, or more than 15);
+  ///   the normals likewise with `Point_cloud::normal_digits`.
+  ///
+  /// Guarantee of `PRECISION_AS_READ`: if the cloud was read from a `.xyz`/`.pwn` file
+  /// and its values were not changed since, except for the signs of some values (e.g.
+  /// flipped normals; which signs changed is the caller's business), then reading the
+  /// file written gives, bit for bit, the `double` values that reading the input gave
+  /// (with the changed signs). Reason: a decimal number with `D <= 15` (`DBL_DIG`)
+  /// significant digits read as the nearest `double` and printed back with `D` digits
+  /// gives the same decimal number, which reads back to the same `double`; negating a
+  /// `double` and its text are both exact. Above 15 digits this does not hold for `D`
+  /// digits, and the shortest exact text is used. The written text may differ from
+  /// the input text (`1.50` is written `1.5`, `1e3` is written `1e+03`), not the values.
+  /// An ASCII PLY file is always written with the shortest exact representation of each
+  /// value in its declared type, so that it round-trips.
   int precision = 9;
+  /// `.xyz`/`.pwn` only: number of threads formatting the text. 0 chooses automatically:
+  /// one thread for a small cloud (less than about 4 MB of text), otherwise
+  /// `std::thread::hardware_concurrency()` threads, at most 8. A positive value is used
+  /// whatever the size, at most 8. The file written does not depend on it, byte for byte.
+  unsigned int number_of_threads = 0;
 };
 
 namespace internal {
@@ -353,12 +417,19 @@ inline char* format_general_fast(char* out, double value, int precision)
   }
   if(digits < integer_powers[precision - 1] || digits >= integer_powers[precision]) return nullptr;
 
-  // The `precision` digits, then without trailing zeros.
+  // The `precision` digits, two at a time, then without trailing zeros.
+  static const char pairs[] = "00010203040506070809101112131415161718192021222324252627282930313233343536373839"
+                              "40414243444546474849505152535455565758596061626364656667686970717273747576777879"
+                              "8081828384858687888990919293949596979899";
   char text[12];
-  for(int i = precision - 1; i >= 0; --i) {
-    text[i] = static_cast<char>('0' + digits % 10);
-    digits /= 10;
+  int position = precision;
+  for(; position >= 2; position -= 2) {
+    const std::size_t pair = static_cast<std::size_t>(digits % 100) * 2;
+    digits /= 100;
+    text[position - 2] = pairs[pair];
+    text[position - 1] = pairs[pair + 1];
   }
+  if(position == 1) text[0] = static_cast<char>('0' + digits);
   int length = precision;
   while(length > 1 && text[length - 1] == '0') --length;
 
@@ -390,6 +461,65 @@ inline char* format_general_fast(char* out, double value, int precision)
     for(int i = 0; i < length; ++i) *out++ = text[i];
   }
   return out;
+}
+
+/// \brief Room needed by `format_real()` (at most 24 characters are written).
+constexpr std::size_t max_real_length = 32;
+
+/// \brief Writes `value` at `out` with `precision` significant digits (`%g` style, at
+/// most 17 are used), or with the shortest text that reads back to the same `double`
+/// if `precision <= 0`; `out` must have room for `max_real_length` characters. Returns
+/// the end of the text.
+inline char* format_real(char* out, double value, int precision)
+{
+  if(precision <= 0) return std::to_chars(out, out + max_real_length, value).ptr;
+  if(char* end = format_general_fast(out, value, precision)) return end;
+  return std::to_chars(out, out + max_real_length, value, std::chars_format::general, std::min(precision, 17)).ptr;
+}
+
+/// \brief Number of significant digits of the decimal number `[begin, end)`, as
+/// written: the digits of the mantissa from the first non-zero one on, trailing zeros
+/// included (`0.012345` has 5, `-1.2300e5` has 5, `0012` has 2); 1 if they are all
+/// zeros (`-0`, `0.000`). The sign, the decimal point and the exponent are not counted.
+inline int significant_digits(const char* begin, const char* end)
+{
+  const char* p = begin;
+  if(p != end && (*p == '-' || *p == '+')) ++p;
+  while(p != end && (*p == '0' || *p == '.')) ++p; // leading zeros
+  int digits = 0;
+  for(; p != end; ++p) {
+    if(static_cast<unsigned char>(*p - '0') > 9) {
+      if(*p == '.') continue;
+      break; // exponent
+    }
+    ++digits;
+  }
+  return digits == 0 ? 1 : digits;
+}
+
+/// \brief Number of `'\n'` in `[begin, end)` (as `std::count`, eight bytes at a time).
+inline std::size_t count_newlines(const char* begin, const char* end)
+{
+  constexpr std::uint64_t ones = 0x0101010101010101ull;
+  constexpr std::uint64_t low7 = 0x7F7F7F7F7F7F7F7Full;
+  std::size_t count = 0;
+  while(static_cast<std::size_t>(end - begin) >= 8) {
+    // Up to 255 words at a time: one counter byte per byte position.
+    const std::size_t words = std::min<std::size_t>(static_cast<std::size_t>(end - begin) / 8, 255);
+    std::uint64_t counters = 0;
+    for(std::size_t w = 0; w < words; ++w, begin += 8) {
+      std::uint64_t word = 0;
+      std::memcpy(&word, begin, 8);
+      const std::uint64_t x = word ^ (ones * '\n');               // zero bytes where '\n'
+      const std::uint64_t nonzero = ((x & low7) + low7) | x;      // high bit set iff byte != 0
+      counters += (~nonzero >> 7) & ones;
+    }
+    // Sum of the eight counter bytes (at most 8 * 255), through four 16-bit sums.
+    constexpr std::uint64_t low_bytes = 0x00FF00FF00FF00FFull;
+    const std::uint64_t pairs = (counters & low_bytes) + ((counters >> 8) & low_bytes);
+    count += static_cast<std::size_t>((pairs * 0x0001000100010001ull) >> 48);
+  }
+  return count + static_cast<std::size_t>(std::count(begin, end, '\n'));
 }
 
 /// \brief Smallest and largest values of the integer PLY type `type`.
@@ -967,18 +1097,8 @@ public:
   /// text if `precision <= 0`.
   void put_real(double value, int precision)
   {
-    if(precision <= 0) {
-      put_shortest(value);
-      return;
-    }
     char* first = room(max_number_length);
-    if(char* fast_end = format_general_fast(first, value, precision)) {
-      used_ += static_cast<std::size_t>(fast_end - first);
-      return;
-    }
-    const std::to_chars_result result = std::to_chars(first, first + max_number_length, value,
-                                                      std::chars_format::general, std::min(precision, 17));
-    used_ += static_cast<std::size_t>(result.ptr - first);
+    used_ += static_cast<std::size_t>(format_real(first, value, precision) - first);
   }
 
   /// Writes the remaining data, closes the temporary file and renames it over the target.
@@ -1062,27 +1182,114 @@ inline void check_writable(const std::string& filename, const Point_cloud& cloud
   }
 }
 
-} // namespace internal
+// ----------------------------------------------------------------- parallel text files
 
-/// \brief Reads a text point cloud (`.xyz` or `.pwn` layout) from `filename`, whatever
-/// its extension.
-///
-/// Each line holds `x y z` or `x y z nx ny nz`, separated by blanks; every data line
-/// must have the same number of values. Blank lines and lines starting with `#` are
-/// skipped. Normals may be zero but coordinates and normals must be finite.
-/// \throws Io_error on any error (unreadable file, non-numeric token, wrong column count,
-/// non-finite value), naming the file and the line.
-inline Point_cloud read_xyz(const std::string& filename)
+/// \brief Text size above which `.xyz`/`.pwn` files are parsed and formatted by several
+/// threads when the number of threads is chosen automatically.
+constexpr std::size_t parallel_text_size = std::size_t(4) << 20;
+
+/// \brief Largest number of threads parsing or formatting a text file.
+constexpr unsigned int max_text_threads = 8;
+
+/// \brief Number of threads for a text of about `size` bytes: `requested` if positive,
+/// otherwise 1 up to `parallel_text_size` bytes and the number of hardware threads
+/// above; at most `max_text_threads` in all cases.
+inline unsigned int text_thread_count(unsigned int requested, std::size_t size)
 {
-  using namespace internal;
-  const File_content content = read_file_content(filename);
-  const char* p = content.begin();
-  const char* const end = content.end();
-  Point_cloud cloud;
-  cloud.points.reserve(static_cast<std::size_t>(std::count(p, end, '\n')) + 1);
+  if(requested > 0) return std::min(requested, max_text_threads);
+  if(size <= parallel_text_size) return 1;
+  const unsigned int hardware = std::thread::hardware_concurrency(); // 0 if unknown
+  return std::max(1u, std::min(hardware, max_text_threads));
+}
+
+/// \brief Calls `task(i)` for every `i` in `[0, count)`, concurrently: `task(0)` in the
+/// calling thread, the others in new threads (in the calling thread, after `task(0)`,
+/// if no more threads can be started). Returns when all calls have returned; then
+/// rethrows the exception of the call with the smallest `i` that threw, if any.
+template <class Task>
+inline void run_concurrently(std::size_t count, const Task& task)
+{
+  if(count == 0) return;
+  std::vector<std::exception_ptr> errors(count);
+  auto run = [&task, &errors](std::size_t i) {
+    try {
+      task(i);
+    } catch(...) {
+      errors[i] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> threads;
+  threads.reserve(count - 1); // emplace_back below does not reallocate
+  std::size_t started = 1;
+  try {
+    for(; started < count; ++started) threads.emplace_back(run, started);
+  } catch(...) {
+    // No more threads: the remaining calls are made by the calling thread.
+  }
+  run(0);
+  for(std::size_t i = started; i < count; ++i) run(i);
+  for(std::thread& thread : threads) thread.join();
+  for(const std::exception_ptr& error : errors)
+    if(error) std::rethrow_exception(error);
+}
+
+/// \brief Splits `[begin, end)` into `parts` consecutive chunks of about the same size,
+/// each made of whole lines (a chunk ends just after a `'\n'`, or at `end`; some chunks
+/// may be empty). Returns the `parts + 1` chunk bounds.
+inline std::vector<const char*> split_at_lines(const char* begin, const char* end, unsigned int parts)
+{
+  std::vector<const char*> bounds(1, begin);
+  const std::size_t step = static_cast<std::size_t>(end - begin) / std::max(parts, 1u);
+  for(unsigned int i = 1; i < parts; ++i) {
+    const char* target = std::max(begin + step * i, bounds.back());
+    const char* eol = end_of_line(target, end);
+    bounds.push_back(eol < end ? eol + 1 : end);
+  }
+  bounds.push_back(end);
+  return bounds;
+}
+
+/// \brief Errors found while parsing a `.xyz`/`.pwn` text.
+enum class Xyz_error
+{
+  NONE,
+  NON_NUMERIC,
+  OUT_OF_RANGE,
+  COLUMN_COUNT,    // neither 3 nor 6 values
+  COLUMN_MISMATCH, // not as many values as the first data line
+  NON_FINITE_COORDINATE,
+  NON_FINITE_NORMAL
+};
+
+/// \brief Result of parsing a chunk of whole lines of a `.xyz`/`.pwn` text on its own;
+/// line numbers are relative to the chunk (the first line of the chunk is line 1).
+struct Xyz_chunk
+{
+  std::vector<std::array<double, 3>> points;
+  std::vector<std::array<double, 3>> normals;
+  std::size_t lines = 0;           // lines of the chunk (unset after an error)
+  std::size_t columns = 0;         // values of the first data line, 0 if none
+  std::size_t first_data_line = 0; // 0 if none
+  int point_digits = 0;            // as `Point_cloud::point_digits` (unset after an error)
+  int normal_digits = 0;           // as `Point_cloud::normal_digits` (unset after an error)
+  Xyz_error error = Xyz_error::NONE; // first error of the chunk, which stops parsing
+  std::size_t error_line = 0;
+  std::size_t error_values = 0; // COLUMN_COUNT, COLUMN_MISMATCH: values on the line
+  std::string error_token;      // NON_NUMERIC, OUT_OF_RANGE: the token, quoted
+};
+
+/// \brief Parses the whole lines `[p, end)` of a `.xyz`/`.pwn` text into `chunk`, as
+/// `read_xyz()` specifies, up to the first error, which is recorded in `chunk`.
+inline void parse_xyz_chunk(const char* p, const char* const end, Xyz_chunk& chunk)
+{
+  chunk.points.reserve(count_newlines(p, end) + 1);
   std::size_t columns = 0;
-  std::size_t first_data_line = 0;
   std::size_t line = 0;
+  int digits[2] = {0, 0}; // of coordinates, of normals
+  auto failed = [&chunk, &line](Xyz_error error) {
+    chunk.error = error;
+    chunk.error_line = line;
+  };
   while(p < end) {
     ++line;
     const char* const eol = end_of_line(p, end);
@@ -1098,41 +1305,175 @@ inline Point_cloud read_xyz(const std::string& filename)
         const char* first = (*q == '+' && q + 1 != eol && q[1] != '-' && q[1] != '+') ? q + 1 : q;
         const std::from_chars_result result = std::from_chars(first, eol, values[n]);
         if(result.ec == std::errc() && (result.ptr == eol || is_blank(*result.ptr))) {
+          // Count the digits only if the token may have more than `maximum`: it has at
+          // most as many as characters, its sign and a leading `0.` excluded.
+          int& maximum = digits[n < 3 ? 0 : 1];
+          const char* const unsigned_first = first + (*first == '-');
+          std::ptrdiff_t bound = result.ptr - unsigned_first;
+          if(bound >= 2 && unsigned_first[0] == '0' && unsigned_first[1] == '.') bound -= 2;
+          if(bound > maximum || maximum == 0) maximum = std::max(maximum, significant_digits(first, result.ptr));
           q = result.ptr;
           ++n;
           continue;
         }
         const char* token_end = q;
         while(token_end != eol && !is_blank(*token_end)) ++token_end;
-        if(result.ec == std::errc::result_out_of_range && result.ptr == token_end)
-          fail(filename, "number " + quoted(q, token_end) + " out of range at line " + std::to_string(line));
-        fail(filename, "non-numeric token " + quoted(q, token_end) + " at line " + std::to_string(line));
+        chunk.error_token = quoted(q, token_end);
+        const bool out_of_range = result.ec == std::errc::result_out_of_range && result.ptr == token_end;
+        return failed(out_of_range ? Xyz_error::OUT_OF_RANGE : Xyz_error::NON_NUMERIC);
       }
       while(q != eol && !is_blank(*q)) ++q;
       ++n;
     }
     if(n == 0) continue; // blank or comment line
-    if(n != 3 && n != 6)
-      fail(filename, "wrong column count at line " + std::to_string(line) + ": " + std::to_string(n) +
-                       " values, expected 3 (x y z) or 6 (x y z nx ny nz)");
+    if(n != 3 && n != 6) {
+      chunk.error_values = n;
+      return failed(Xyz_error::COLUMN_COUNT);
+    }
     if(columns == 0) {
       columns = n;
-      first_data_line = line;
-      if(columns == 6) cloud.normals.reserve(cloud.points.capacity());
+      chunk.columns = n;
+      chunk.first_data_line = line;
+      if(columns == 6) chunk.normals.reserve(chunk.points.capacity());
     } else if(n != columns) {
-      fail(filename, "wrong column count at line " + std::to_string(line) + ": " + std::to_string(n) +
-                       " values, but line " + std::to_string(first_data_line) + " has " + std::to_string(columns));
+      chunk.error_values = n;
+      return failed(Xyz_error::COLUMN_MISMATCH);
     }
     if(!(std::isfinite(values[0]) && std::isfinite(values[1]) && std::isfinite(values[2])))
-      fail(filename, "non-finite coordinate at line " + std::to_string(line));
-    cloud.points.push_back({{values[0], values[1], values[2]}});
+      return failed(Xyz_error::NON_FINITE_COORDINATE);
+    chunk.points.push_back({{values[0], values[1], values[2]}});
     if(n == 6) {
       if(!(std::isfinite(values[3]) && std::isfinite(values[4]) && std::isfinite(values[5])))
-        fail(filename, "non-finite normal at line " + std::to_string(line));
-      cloud.normals.push_back({{values[3], values[4], values[5]}});
+        return failed(Xyz_error::NON_FINITE_NORMAL);
+      chunk.normals.push_back({{values[3], values[4], values[5]}});
     }
   }
+  chunk.lines = line;
+  chunk.point_digits = digits[0];
+  chunk.normal_digits = digits[1];
+}
+
+/// \brief The cloud made of the consecutive `chunks` of the text file `filename`, or
+/// the first error in file order, with line numbers counted from the start of the file.
+/// The chunks are consumed.
+inline Point_cloud merge_xyz_chunks(const std::string& filename, std::vector<Xyz_chunk>& chunks)
+{
+  std::size_t columns = 0;
+  std::size_t first_data_line = 0;
+  std::size_t lines_before = 0; // lines of the previous chunks
+  auto wrong_columns = [&](std::size_t line, std::size_t values) {
+    return "wrong column count at line " + std::to_string(line) + ": " + std::to_string(values) +
+           " values, but line " + std::to_string(first_data_line) + " has " + std::to_string(columns);
+  };
+  Point_cloud cloud;
+  std::size_t point_count = 0;
+  for(const Xyz_chunk& chunk : chunks) {
+    if(chunk.columns != 0) {
+      // No error precedes the first data line of a chunk.
+      if(columns == 0) {
+        columns = chunk.columns;
+        first_data_line = lines_before + chunk.first_data_line;
+      } else if(chunk.columns != columns) {
+        fail(filename, wrong_columns(lines_before + chunk.first_data_line, chunk.columns));
+      }
+    }
+    const std::string at_line = " at line " + std::to_string(lines_before + chunk.error_line);
+    switch(chunk.error) {
+    case Xyz_error::NONE: break;
+    case Xyz_error::NON_NUMERIC: fail(filename, "non-numeric token " + chunk.error_token + at_line);
+    case Xyz_error::OUT_OF_RANGE: fail(filename, "number " + chunk.error_token + " out of range" + at_line);
+    case Xyz_error::COLUMN_COUNT:
+      fail(filename, "wrong column count" + at_line + ": " + std::to_string(chunk.error_values) +
+                       " values, expected 3 (x y z) or 6 (x y z nx ny nz)");
+    case Xyz_error::COLUMN_MISMATCH:
+      fail(filename, wrong_columns(lines_before + chunk.error_line, chunk.error_values));
+    case Xyz_error::NON_FINITE_COORDINATE: fail(filename, "non-finite coordinate" + at_line);
+    case Xyz_error::NON_FINITE_NORMAL: fail(filename, "non-finite normal" + at_line);
+    }
+    lines_before += chunk.lines;
+    point_count += chunk.points.size();
+    cloud.point_digits = std::max(cloud.point_digits, chunk.point_digits);
+    cloud.normal_digits = std::max(cloud.normal_digits, chunk.normal_digits);
+  }
+  if(chunks.size() == 1) {
+    cloud.points = std::move(chunks[0].points);
+    cloud.normals = std::move(chunks[0].normals);
+    return cloud;
+  }
+  cloud.points.reserve(point_count);
+  if(columns == 6) cloud.normals.reserve(point_count);
+  for(Xyz_chunk& chunk : chunks) {
+    cloud.points.insert(cloud.points.end(), chunk.points.begin(), chunk.points.end());
+    cloud.normals.insert(cloud.normals.end(), chunk.normals.begin(), chunk.normals.end());
+    chunk.points = {};
+    chunk.normals = {};
+  }
   return cloud;
+}
+
+/// \brief Writes the lines of points `[first, last)` of `cloud` as `write_xyz()`
+/// specifies at `out`, which must have room for `(last - first) * 6 * (max_real_length
+/// + 1)` characters; returns the end of the text.
+inline char* format_xyz_lines(char* out, const Point_cloud& cloud, std::size_t first, std::size_t last,
+                              int point_precision, int normal_precision)
+{
+  const bool normals = cloud.has_normals();
+  for(std::size_t i = first; i < last; ++i) {
+    const std::array<double, 3>& p = cloud.points[i];
+    out = format_real(out, p[0], point_precision);
+    *out++ = ' ';
+    out = format_real(out, p[1], point_precision);
+    *out++ = ' ';
+    out = format_real(out, p[2], point_precision);
+    if(normals) {
+      const std::array<double, 3>& v = cloud.normals[i];
+      *out++ = ' ';
+      out = format_real(out, v[0], normal_precision);
+      *out++ = ' ';
+      out = format_real(out, v[1], normal_precision);
+      *out++ = ' ';
+      out = format_real(out, v[2], normal_precision);
+    }
+    *out++ = '\n';
+  }
+  return out;
+}
+
+/// \brief Precision used for values read with `digits` significant digits when the
+/// requested precision is `requested` (see `Write_options::precision`).
+inline int effective_precision(int requested, int digits)
+{
+  if(requested >= 0) return requested;
+  return (digits >= 1 && digits <= DBL_DIG) ? digits : Write_options::PRECISION_SHORTEST;
+}
+
+/// \brief Number of points formatted at once by one thread of `write_xyz()`.
+constexpr std::size_t xyz_block_points = 16384;
+
+} // namespace internal
+
+/// \brief Reads a text point cloud (`.xyz` or `.pwn` layout) from `filename`, whatever
+/// its extension.
+///
+/// Each line holds `x y z` or `x y z nx ny nz`, separated by blanks; every data line
+/// must have the same number of values. Blank lines and lines starting with `#` are
+/// skipped. Normals may be zero but coordinates and normals must be finite. The largest
+/// numbers of significant digits of the coordinates and of the normals are recorded in
+/// `point_digits` and `normal_digits`. A large file is parsed by several threads (see
+/// `Read_options::number_of_threads`), with the same result.
+/// \throws Io_error on any error (unreadable file, non-numeric token, wrong column count,
+/// non-finite value), naming the file and the line; with several errors, the first one
+/// in the file.
+inline Point_cloud read_xyz(const std::string& filename, const Read_options& options = Read_options())
+{
+  using namespace internal;
+  const File_content content = read_file_content(filename);
+  const unsigned int threads = text_thread_count(options.number_of_threads, content.size);
+  const std::vector<const char*> bounds = split_at_lines(content.begin(), content.end(), threads);
+  std::vector<Xyz_chunk> chunks(threads);
+  run_concurrently(threads,
+                   [&bounds, &chunks](std::size_t i) { parse_xyz_chunk(bounds[i], bounds[i + 1], chunks[i]); });
+  return merge_xyz_chunks(filename, chunks);
 }
 
 /// \brief Reads a PLY point cloud from `filename`, whatever its extension.
@@ -1186,49 +1527,84 @@ inline Point_cloud read_ply(const std::string& filename)
 }
 
 /// \brief Reads a point cloud from `filename`, choosing the format from the extension
-/// (case-insensitive): `.xyz` and `.pwn` with `read_xyz()`, `.ply` with `read_ply()`.
+/// (case-insensitive): `.xyz` and `.pwn` with `read_xyz()`, `.ply` with `read_ply()`
+/// (which ignores `options`).
 /// \throws Io_error on an unknown extension or on any reading error.
-inline Point_cloud read_point_cloud(const std::string& filename)
+inline Point_cloud read_point_cloud(const std::string& filename, const Read_options& options = Read_options())
 {
   const std::string extension = internal::lower_case_extension(filename);
-  if(extension == ".xyz" || extension == ".pwn") return read_xyz(filename);
+  if(extension == ".xyz" || extension == ".pwn") return read_xyz(filename, options);
   if(extension == ".ply") return read_ply(filename);
   internal::fail(filename, "unknown point cloud file extension '" + extension +
                              "' (expected .xyz, .pwn or .ply)");
 }
 
 /// \brief Writes `cloud` to `filename` as text, whatever its extension: one line
-/// `x y z nx ny nz` per point (`x y z` without normals), with `options.precision`
-/// significant digits. Extra properties are not written.
+/// `x y z nx ny nz` per point (`x y z` without normals), with the precision given by
+/// `options.precision` (see `Write_options::precision`, notably `PRECISION_AS_READ`).
+/// Extra properties are not written.
 ///
-/// The file is written atomically (temporary file renamed over `filename`).
+/// A large cloud is formatted by several threads (see `Write_options::number_of_threads`),
+/// each formatting blocks of points that are written in order: the file does not depend
+/// on the number of threads. The file is written atomically (temporary file renamed
+/// over `filename`).
 /// \throws Io_error if `cloud` is inconsistent or not finite, or on any writing error;
 /// no file is left behind then and an existing `filename` is unchanged.
 inline void write_xyz(const std::string& filename, const Point_cloud& cloud,
                       const Write_options& options = Write_options())
 {
-  internal::check_writable(filename, cloud, false);
-  internal::Atomic_output_file out(filename);
-  const bool normals = cloud.has_normals();
-  const int precision = options.precision;
-  for(std::size_t i = 0; i < cloud.points.size(); ++i) {
-    const std::array<double, 3>& p = cloud.points[i];
-    out.put_real(p[0], precision);
-    out.put(' ');
-    out.put_real(p[1], precision);
-    out.put(' ');
-    out.put_real(p[2], precision);
-    if(normals) {
-      const std::array<double, 3>& n = cloud.normals[i];
-      out.put(' ');
-      out.put_real(n[0], precision);
-      out.put(' ');
-      out.put_real(n[1], precision);
-      out.put(' ');
-      out.put_real(n[2], precision);
+  using namespace internal;
+  check_writable(filename, cloud, false);
+  Atomic_output_file out(filename);
+  const int point_precision = effective_precision(options.precision, cloud.point_digits);
+  const int normal_precision = effective_precision(options.precision, cloud.normal_digits);
+  const std::size_t n = cloud.points.size();
+  const std::size_t columns = cloud.has_normals() ? 6 : 3;
+  const std::size_t blocks = (n + xyz_block_points - 1) / xyz_block_points;
+  const std::size_t estimated_size = n * columns * 12; // about 12 bytes per value
+  const std::size_t threads = std::min<std::size_t>(text_thread_count(options.number_of_threads, estimated_size),
+                                                    std::max<std::size_t>(blocks, 1));
+  const std::size_t buffer_size = std::min(n, xyz_block_points) * columns * (max_real_length + 1) + 1;
+
+  // Each thread takes the next block, formats it in its buffer, waits for the previous
+  // blocks to be written, then writes it: blocks are formatted concurrently and written
+  // in order, by one thread at a time.
+  std::atomic<std::size_t> next_block{0};
+  std::mutex mutex;
+  std::condition_variable turn_changed;
+  std::size_t turn = 0;  // next block to write (guarded by `mutex`)
+  bool aborted = false;  // a write failed (guarded by `mutex`)
+  run_concurrently(threads, [&](std::size_t) {
+    const std::unique_ptr<char[]> buffer(new char[buffer_size]);
+    for(;;) {
+      const std::size_t block = next_block.fetch_add(1);
+      if(block >= blocks) return;
+      const std::size_t first = block * xyz_block_points;
+      const char* const text_end = format_xyz_lines(buffer.get(), cloud, first,
+                                                    std::min(n, first + xyz_block_points),
+                                                    point_precision, normal_precision);
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        turn_changed.wait(lock, [&] { return turn == block || aborted; });
+        if(aborted) return;
+      }
+      try {
+        out.put(std::string_view(buffer.get(), static_cast<std::size_t>(text_end - buffer.get())));
+      } catch(...) {
+        {
+          const std::lock_guard<std::mutex> lock(mutex);
+          aborted = true;
+        }
+        turn_changed.notify_all();
+        throw;
+      }
+      {
+        const std::lock_guard<std::mutex> lock(mutex);
+        ++turn;
+      }
+      turn_changed.notify_all();
     }
-    out.put('\n');
-  }
+  });
   out.commit();
 }
 
