@@ -31,6 +31,7 @@
 #include <stdexcept>
 #include <string>
 #include <thread>
+#include <type_traits>
 #include <vector>
 
 #ifndef NORMAL_ORIENTATION_BENCHMARK_OURS
@@ -274,13 +275,15 @@ struct Child_result
   double peak_mb = 0.0;
 };
 
-/// Writes `size` bytes to `fd`, retrying on EINTR and short writes; returns false on error.
-bool write_all(int fd, const void* data, std::size_t size)
+/// Moves exactly `size` bytes between `fd` and `data` with `transfer` (::read or ::write),
+/// retrying on EINTR and short transfers; returns false on end of file or error.
+template <typename Buffer, typename Transfer>
+bool transfer_all(int fd, Buffer* data, std::size_t size, Transfer transfer)
 {
-  const char* p = static_cast<const char*>(data);
+  auto* p = reinterpret_cast<std::conditional_t<std::is_const<Buffer>::value, const char, char>*>(data);
   while(size > 0)
   {
-    const ssize_t n = ::write(fd, p, size);
+    const ssize_t n = transfer(fd, p, size);
     if(n < 0 && errno == EINTR)
       continue;
     if(n <= 0)
@@ -291,22 +294,11 @@ bool write_all(int fd, const void* data, std::size_t size)
   return true;
 }
 
+/// Writes `size` bytes to `fd`, retrying on EINTR and short writes; returns false on error.
+bool write_all(int fd, const void* data, std::size_t size) { return transfer_all(fd, data, size, ::write); }
+
 /// Reads exactly `size` bytes from `fd`, retrying on EINTR; returns false on EOF or error.
-bool read_all(int fd, void* data, std::size_t size)
-{
-  char* p = static_cast<char*>(data);
-  while(size > 0)
-  {
-    const ssize_t n = ::read(fd, p, size);
-    if(n < 0 && errno == EINTR)
-      continue;
-    if(n <= 0)
-      return false;
-    p += n;
-    size -= static_cast<std::size_t>(n);
-  }
-  return true;
-}
+bool read_all(int fd, void* data, std::size_t size) { return transfer_all(fd, data, size, ::read); }
 
 /// Sends a length-prefixed string over `fd`.
 bool write_string(int fd, const std::string& s)
