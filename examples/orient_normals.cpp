@@ -306,7 +306,10 @@ int main_impl(int argc, char** argv)
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   };
 
-  NO::IO::Point_cloud cloud = NO::IO::read_point_cloud(o.input);
+  // --threads bounds every stage: reading, orienting and writing.
+  NO::IO::Read_options ro;
+  ro.number_of_threads = unsigned(o.threads > 1 ? o.threads : (o.threads == 1 ? 1 : 0));
+  NO::IO::Point_cloud cloud = NO::IO::read_point_cloud(o.input, ro);
   const double read_seconds = since(t0);
   if (cloud.size() == 0)
     throw std::runtime_error(o.input + ": the file holds no point");
@@ -350,6 +353,7 @@ int main_impl(int argc, char** argv)
   const auto tw = std::chrono::steady_clock::now();
   NO::IO::Write_options wo;
   wo.binary = !o.ascii;
+  wo.number_of_threads = ro.number_of_threads;
   // The digits the input text had (or the shortest exact text): values read
   // back from the output equal, bit for bit, those read from the input.
   wo.precision = NO::IO::Write_options::PRECISION_AS_READ;
