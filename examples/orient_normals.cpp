@@ -308,7 +308,7 @@ int main_impl(int argc, char** argv)
 
   // --threads bounds every stage: reading, orienting and writing.
   NO::IO::Read_options ro;
-  ro.number_of_threads = unsigned(o.threads > 1 ? o.threads : (o.threads == 1 ? 1 : 0));
+  ro.number_of_threads = unsigned(o.threads); // 0: automatic
   NO::IO::Point_cloud cloud = NO::IO::read_point_cloud(o.input, ro);
   const double read_seconds = since(t0);
   if (cloud.size() == 0)
