@@ -287,9 +287,30 @@ TEST(Mst_solver, IsNotOptimalOnTheFigure2Graph)
   // 1.4; the optimum pays 1.0 (violate the strong edge only).
   const Ugraph g = make_graph(4, {{0, 1, -1.0}, {0, 2, 0.7}, {2, 1, 0.7}, {0, 3, 0.7}, {3, 1, 0.7}});
   std::vector<NO::Label> labels(4);
-  const auto report = NO::Mst_solver().solve(g, get(boost::edge_weight, g), CGAL::make_property_map(labels));
-  EXPECT_NEAR(report.energy, 1.4, 1e-12);
+  const auto report = NO::Mst_solver(0).solve(g, get(boost::edge_weight, g), CGAL::make_property_map(labels));
+  EXPECT_NEAR(report.energy, 1.4, 1e-6);
   EXPECT_NEAR(brute_force_minimum(g), 1.0, 1e-12);
+  // the default solver's single-vertex moves find the optimum here: vertex
+  // 1 has two 0.7 edges for agreeing and one 1.0 edge against
+  const auto improved = NO::Mst_solver().solve(g, get(boost::edge_weight, g), CGAL::make_property_map(labels));
+  EXPECT_NEAR(improved.energy, 1.0, 1e-6);
+}
+
+TEST(Mst_solver, LocalSweepsNeverEndAboveTheForest)
+{
+  std::mt19937_64 rng(17);
+  int better = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const int n = 3 + int(rng() % 60);
+    const auto edges = random_signed_graph(rng, n, 2 * n + int(rng() % (3 * n)), false);
+    const Ugraph g = make_graph(n, edges);
+    std::vector<NO::Label> a(n), b(n);
+    const double forest = NO::Mst_solver(0).solve(g, get(boost::edge_weight, g), CGAL::make_property_map(a)).energy;
+    const double swept = NO::Mst_solver(3).solve(g, get(boost::edge_weight, g), CGAL::make_property_map(b)).energy;
+    ASSERT_LE(swept, forest + 1e-5) << "trial " << trial;
+    better += swept < forest - 1e-9;
+  }
+  EXPECT_GT(better, 0);
 }
 
 TEST(Mst_solver, NeverBelowBruteForceAndDeterministic)
@@ -303,12 +324,12 @@ TEST(Mst_solver, NeverBelowBruteForceAndDeterministic)
       e.w = e.w > 0 ? 0.5 : -0.5; // many ties: exercise the tie-breaking
     const Ugraph g = make_graph(n, edges);
     std::vector<NO::Label> a(n), b(n);
-    const double ea = NO::Mst_solver().solve(g, get(boost::edge_weight, g), CGAL::make_property_map(a)).energy;
-    NO::Mst_solver().solve(g, get(boost::edge_weight, g), CGAL::make_property_map(b));
+    const double ea = NO::Mst_solver(0).solve(g, get(boost::edge_weight, g), CGAL::make_property_map(a)).energy;
+    NO::Mst_solver(0).solve(g, get(boost::edge_weight, g), CGAL::make_property_map(b));
     ASSERT_EQ(a, b);
     const double best = brute_force_minimum(g);
-    ASSERT_GE(ea, best - 1e-12);
-    optimal += ea <= best + 1e-12;
+    ASSERT_GE(ea, best - 1e-6);
+    optimal += ea <= best + 1e-6;
   }
   EXPECT_GT(optimal, 0);
   EXPECT_LT(optimal, 100); // MST is not exact on frustrated graphs

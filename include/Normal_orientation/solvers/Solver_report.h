@@ -16,7 +16,8 @@ struct Solver_report
 {
   /// the energy of the labelling written by the solver
   double energy = 0.0;
-  /// solver-specific count: edges processed (MST), re-solves (QPBO-I), ...
+  /// solver-specific count: edges processed plus single-vertex moves (MST),
+  /// re-solves (QPBO-I), ...
   std::size_t iterations = 0;
   /// edges that joined two different components (MST: the spanning forest)
   std::size_t tree_edges = 0;
