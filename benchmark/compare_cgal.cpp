@@ -927,27 +927,28 @@ int main(int argc, char** argv)
         Row row{mesh_name, options.points, noise, {}, {}};
         std::string failure_report;
         // Alternate the two programs so that a load change on the machine hits both alike.
-        for(unsigned int r = 0; r < options.repeat; ++r)
+        struct Side
         {
-          if(r == 0 || row.ours.ok)
+          const char* name;
+          const std::vector<std::string>* command;
+          const std::string* output;
+          const char* suffix;
+          Side_result* result;
+        };
+        const Side sides[2] = {{"ours", &ours_command, &ours_output, ".ours", &row.ours},
+                               {"CGAL", &cgal_command, &cgal_output, ".cgal", &row.cgal}};
+        for(unsigned int r = 0; r < options.repeat; ++r)
+          for(const Side& side : sides)
           {
-            const Side_result run = run_side(spawner, "ours", ours_command, ours_output, prefix + ".ours", cloud,
-                                             tolerance, failure_report);
+            if(r > 0 && !side.result->ok)
+              continue;
+            const Side_result run = run_side(spawner, side.name, *side.command, *side.output,
+                                             prefix + side.suffix, cloud, tolerance, failure_report);
             if(r == 0)
-              row.ours = run;
+              *side.result = run;
             else
-              merge_repeat(row.ours, run);
+              merge_repeat(*side.result, run);
           }
-          if(r == 0 || row.cgal.ok)
-          {
-            const Side_result run = run_side(spawner, "CGAL", cgal_command, cgal_output, prefix + ".cgal", cloud,
-                                             tolerance, failure_report);
-            if(r == 0)
-              row.cgal = run;
-            else
-              merge_repeat(row.cgal, run);
-          }
-        }
         std::fprintf(stderr, ", ours %.2f s%s, CGAL %.2f s%s\n%s", row.ours.child.seconds,
                      row.ours.ok ? "" : " (FAILED)", row.cgal.child.seconds, row.cgal.ok ? "" : " (FAILED)",
                      failure_report.c_str());
