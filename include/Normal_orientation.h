@@ -13,6 +13,7 @@
 #include <Normal_orientation/Signed_union_find.h>
 #include <Normal_orientation/orient_normals.h>
 #include <Normal_orientation/parameters.h>
+#include <Normal_orientation/solvers/Exhaustive_solver.h>
 #include <Normal_orientation/solvers/Mst_solver.h>
 
 #endif // NORMAL_ORIENTATION_H
