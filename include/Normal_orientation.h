@@ -15,5 +15,6 @@
 #include <Normal_orientation/parameters.h>
 #include <Normal_orientation/solvers/Exhaustive_solver.h>
 #include <Normal_orientation/solvers/Mst_solver.h>
+#include <Normal_orientation/solvers/Qpbo_i_solver.h>
 
 #endif // NORMAL_ORIENTATION_H
