@@ -10,6 +10,7 @@
 
 #include <Normal_orientation/IO/Point_cloud_io.h>
 #include <Normal_orientation/orient_normals.h>
+#include <Normal_orientation/solvers/Qpbo_i_solver.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/jet_estimate_normals.h>
@@ -83,6 +84,7 @@ struct Options
   double radius = 0.0;
   std::string criterion = "hoppe";
   std::string solver = "mst";
+  unsigned int orders = 3;
   std::string sign = "outward";
   bool has_viewpoint = false;
   double viewpoint[3] = {0, 0, 0};
@@ -106,7 +108,8 @@ const char* usage_text =
   "  --k N                neighbours per point (default 12)\n"
   "  --radius R           neighbour radius (default: estimated from the data)\n"
   "  --criterion NAME     flip criterion: hoppe (default), xie, konig\n"
-  "  --solver NAME        solver: mst (default)\n"
+  "  --solver NAME        solver: mst (default), qpbo-i (slower, lower energy)\n"
+  "  --orders N           qpbo-i: random orders tried, the best is kept (default 3)\n"
   "  --sign NAME          component sign: outward (default), keep\n"
   "  --viewpoint X,Y,Z    make every component face this point instead\n"
   "  --normals NAME       estimator when IN has no normals: jet (default), pca\n"
@@ -157,8 +160,13 @@ Options parse_options(int argc, char** argv)
         throw Usage_error("unknown criterion '" + o.criterion + "' (hoppe, xie, konig)");
     } else if (a == "--solver") {
       o.solver = value();
-      if (o.solver != "mst")
-        throw Usage_error("unknown solver '" + o.solver + "' (mst)");
+      if (o.solver != "mst" && o.solver != "qpbo-i")
+        throw Usage_error("unknown solver '" + o.solver + "' (mst, qpbo-i)");
+    } else if (a == "--orders") {
+      const long n = parse_number<long>(a, value());
+      if (n < 1 || n > 1000)
+        throw Usage_error("--orders must be between 1 and 1000");
+      o.orders = unsigned(n);
     } else if (a == "--sign") {
       o.sign = value();
       if (o.sign != "outward" && o.sign != "keep")
@@ -276,8 +284,12 @@ std::string json_escape(const std::string& s)
 }
 
 template <typename Criterion, typename Sign, typename Range, typename Np>
-NO::Orientation_result run(Range& range, const Np& np, const Criterion& criterion, const Sign& sign)
+NO::Orientation_result run(Range& range, const Np& np, const Criterion& criterion, const Sign& sign,
+                           const Options& o)
 {
+  if (o.solver == "qpbo-i")
+    return NO::orient_normals(
+      range, np.flip_criterion(criterion).component_sign(sign).solver(NO::Qpbo_i_solver(o.orders, o.seed)));
   return NO::orient_normals(range, np.flip_criterion(criterion).component_sign(sign));
 }
 
@@ -286,10 +298,11 @@ NO::Orientation_result run_with_criterion(Range& range, const Np& np, const Opti
 {
   auto with_sign = [&](const auto& criterion) {
     if (o.has_viewpoint)
-      return run(range, np, criterion, NO::Viewpoint_component_sign(o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]));
+      return run(range, np, criterion, NO::Viewpoint_component_sign(o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]),
+                 o);
     if (o.sign == "keep")
-      return run(range, np, criterion, NO::Keep_component_sign());
-    return run(range, np, criterion, NO::Outward_component_sign());
+      return run(range, np, criterion, NO::Keep_component_sign(), o);
+    return run(range, np, criterion, NO::Outward_component_sign(), o);
   };
   if (o.criterion == "xie")
     return with_sign(NO::Xie_criterion());

@@ -48,13 +48,17 @@ expect_exit 0 "threads and seed" "$prog" --quiet --threads 1 --seed 5 "$dir/sphe
 expect_exit 0 "two threads" "$prog" --quiet --threads 2 --seed 5 "$dir/sphere.xyz" "$dir/t2.xyz"
 check "same result with 1 and 2 threads" cmp -s "$dir/t1.xyz" "$dir/t2.xyz"
 
+expect_exit 0 "qpbo-i solver" "$prog" --quiet --json --solver qpbo-i --orders 2 "$dir/sphere.xyz" "$dir/qpbo.xyz"
+check "json names the qpbo-i solver" grep -q '"solver": "qpbo-i"' "$dir/out.txt"
+check "qpbo-i normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/qpbo.xyz"
+
 # points without normals: estimated first
 awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/bare.xyz"
 expect_exit 0 "estimates missing normals" "$prog" --quiet --normals pca "$dir/bare.xyz" "$dir/bare_out.xyz"
 check "estimated normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/bare_out.xyz"
 
 # bad options: exit 2, one line on stderr, no output
-for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--threads 0" "--bogus" "--viewpoint 1,2"; do
+for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads 0" "--bogus" "--viewpoint 1,2"; do
   # shellcheck disable=SC2086
   expect_exit 2 "bad option $args" "$prog" $args "$dir/sphere.xyz" "$dir/bad_opt.xyz"
   check "one-line error for $args" test "$(wc -l < "$dir/err.txt")" -eq 1

@@ -41,11 +41,11 @@ namespace Normal_orientation {
 /// was reached by 1 order on 206, 3 orders on 232, 8 orders on 257 and 16
 /// orders on 266 of them; the MST alone on 93.
 ///
-/// Cost: each fix re-solves the max-flow incrementally, then recomputes
-/// the persistent labels in O(V + E); a frustrated problem may need many
-/// fixes, so this version is meant for graphs up to some 10^5 edges (the
-/// segment graphs of the streaming framework, small clouds).  Making it
-/// scale to the full point graph of large clouds is work in progress.
+/// Cost: each re-solve updates the max-flow incrementally, then recomputes
+/// the persistent labels in O(V + E); with `maximum_solves` re-solves per
+/// order, an order costs O(maximum_solves * (V + E)) plus the flow
+/// augmentations.  Solving only the frustrated regions of large clouds is
+/// work in progress.
 /// \cgalModels `OrientationSolver`
 class Qpbo_i_solver
 {
@@ -59,6 +59,13 @@ public:
   unsigned long seed = 0;
   /// the solver that gives the starting labelling
   Mst_solver initial;
+  /// At most this many re-solves per order: the unlabelled nodes are fixed
+  /// in batches of ceil(unlabelled / maximum_solves) between two re-solves,
+  /// one at a time when there are at most `maximum_solves` of them (the
+  /// classical QPBO-I).  Fixing to the starting labelling keeps it feasible,
+  /// so batches keep the guarantee; they trade some of the propagation
+  /// between fixes for a bounded cost of maximum_solves * O(V + E) per order.
+  unsigned int maximum_solves = 64;
 
   /// the solver with `orders` random orders seeded by `seed`
   explicit Qpbo_i_solver(unsigned int orders = 3, unsigned long seed = 0) : orders(orders), seed(seed) {}
@@ -116,13 +123,23 @@ public:
       std::mt19937_64 rng(seed * 0x9e3779b97f4a7c15ULL + o);
       for (std::size_t k = order.size(); k > 1; --k) // Fisher-Yates, independent of the library
         std::swap(order[k - 1], order[std::size_t(rng() % k)]);
+      // Nodes are fixed in batches of ceil(unlabelled / maximum_solves)
+      // between two re-solves (one node at a time on small problems).
+      const std::size_t batch =
+        std::max<std::size_t>(1, (order.size() + maximum_solves - 1) / std::max(1u, maximum_solves));
+      std::size_t in_batch = 0;
       for (std::size_t i : order) {
         if (qpbo.label(i) >= 0)
           continue;
         qpbo.fix(i, y[i] > 0 ? 0 : 1);
         fixed.push_back(i);
-        qpbo.solve();
+        if (++in_batch == batch) {
+          qpbo.solve();
+          in_batch = 0;
+        }
       }
+      if (in_batch > 0)
+        qpbo.solve();
       report.iterations += fixed.size();
       std::vector<Label> x(n);
       for (std::size_t i = 0; i < n; ++i) {
