@@ -56,10 +56,10 @@ struct Named_function_parameters : CGAL::Named_function_parameters<T, Tag, Base>
 
   /// an empty pack
   Named_function_parameters() : Cgal_pack() {}
-  /// a pack holding `v`
-  Named_function_parameters(const T& v) : Cgal_pack(v) {}
-  /// a pack holding `v`, chained to `b`
-  Named_function_parameters(const T& v, const Base& b) : Cgal_pack(v, b) {}
+  /// a pack holding `value`
+  Named_function_parameters(const T& value) : Cgal_pack(value) {}
+  /// a pack holding `value`, chained to `b`
+  Named_function_parameters(const T& value, const Base& b) : Cgal_pack(value, b) {}
 
 /// \cond SKIP_IN_MANUAL
 #define CGAL_add_named_parameter(X, Y, Z)                                  \

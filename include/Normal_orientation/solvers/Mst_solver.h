@@ -111,19 +111,19 @@ public:
     //    The order is fully determined, whatever the number of threads.
     {
       std::vector<Sorted_edge> buffer(sorted.size());
-      std::vector<std::size_t> start(std::size_t(1) << 16);
+      std::vector<std::size_t> bucket_start(std::size_t(1) << 16);
       for (int shift = 0; shift < 32; shift += 16) {
-        std::fill(start.begin(), start.end(), std::size_t(0));
+        std::fill(bucket_start.begin(), bucket_start.end(), std::size_t(0));
         for (const Sorted_edge& e : sorted)
-          ++start[(e.key >> shift) & 0xffffu];
+          ++bucket_start[(e.key >> shift) & 0xffffu];
         std::size_t sum = 0;
-        for (std::size_t& c : start) {
+        for (std::size_t& c : bucket_start) {
           const std::size_t count = c;
           c = sum;
           sum += count;
         }
         for (const Sorted_edge& e : sorted)
-          buffer[start[(e.key >> shift) & 0xffffu]++] = e;
+          buffer[bucket_start[(e.key >> shift) & 0xffffu]++] = e;
         sorted.swap(buffer);
       }
     }

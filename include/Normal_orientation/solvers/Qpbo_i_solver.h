@@ -68,7 +68,9 @@ public:
   unsigned int maximum_solves = 64;
 
   /// the solver with `orders` random orders seeded by `seed`
-  explicit Qpbo_i_solver(unsigned int orders = 3, unsigned long seed = 0) : orders(orders), seed(seed) {}
+  explicit Qpbo_i_solver(unsigned int number_of_orders = 3, unsigned long random_seed = 0)
+    : orders(number_of_orders), seed(random_seed)
+  {}
 
   /// Solves the orientation problem on `g` with the signed edge weights
   /// `weight` and writes +1/-1 to `labels` for every vertex.

@@ -1,0 +1,403 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// solver_quality: energy, wrong normals and solve time of three solvers on the same graphs,
+// in the form of Table 1 of the paper (Schertler et al. 2017).
+//
+// For each mesh and each noise level, generates a cloud in process (Mesh_sampler.h) and
+// orients copies of it with (a) Mst_solver(0), the paper's MST (Algorithm 1), (b) Mst_solver(),
+// our default (MST + 3 local sweeps), and (c) Qpbo_i_solver(orders, seed), MST + QPBO-I.
+// Every other parameter is at its default, so the three runs build the same graph.
+// Prints a Markdown table. See README.md.
+#include "Mesh_sampler.h"
+
+#include <Normal_orientation/orient_normals.h>
+#include <Normal_orientation/parameters.h>
+#include <Normal_orientation/solvers/Mst_solver.h>
+#include <Normal_orientation/solvers/Qpbo_i_solver.h>
+
+#include <CGAL/property_map.h>
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#ifndef NORMAL_ORIENTATION_BENCHMARK_MESH_DIR
+#define NORMAL_ORIENTATION_BENCHMARK_MESH_DIR "/work/shared/data/meshes"
+#endif
+
+namespace {
+
+namespace fs = std::filesystem;
+using namespace Normal_orientation::benchmark;
+
+/// Number of compared solvers.
+constexpr std::size_t number_of_solvers = 3;
+
+/// Column labels of the compared solvers, in table order.
+const std::array<const char*, number_of_solvers> solver_labels = {"MST", "MST+sweeps", "QPBO-I"};
+
+/// Command-line options of solver_quality.
+struct Options
+{
+  /// Mesh files and directories given with --meshes (empty: the default directory).
+  std::vector<std::string> mesh_arguments;
+  /// Points per cloud.
+  std::size_t points = 30000;
+  /// Noise levels (fractions of the bounding-box diagonal).
+  std::vector<double> noises = {0.0, 0.001, 0.005};
+  /// Seed of every cloud and of the QPBO-I orders.
+  std::uint64_t seed = 1;
+  /// Random orders tried by QPBO-I.
+  unsigned int orders = 3;
+  /// Maximum number of threads of orient_normals (0: all).
+  int threads = 0;
+};
+
+/// What one solver gave on one cloud.
+struct Solver_row
+{
+  /// Energy (eq. 3) of the output orientation.
+  double energy = 0.0;
+  /// Normals with dot(n, n_true) <= 0.
+  std::size_t wrong = 0;
+  /// Seconds of the solver stage (Orientation_result::seconds.solve).
+  double solve_seconds = 0.0;
+};
+
+/// One line of the table: a cloud and the result of each solver.
+struct Table_row
+{
+  /// File name of the mesh (without directory).
+  std::string mesh;
+  /// Noise level.
+  double noise = 0.0;
+  /// Number of points.
+  std::size_t points = 0;
+  /// Results, in the order of `solver_labels`.
+  std::array<Solver_row, number_of_solvers> solvers;
+};
+
+/// Prints the usage message to `out`.
+void print_usage(std::FILE* out)
+{
+  std::fprintf(
+    out,
+    "usage: solver_quality [options]\n"
+    "  --meshes DIR_OR_FILES...  meshes (.off files, or directories whose *.off are used);\n"
+    "                            default: " NORMAL_ORIENTATION_BENCHMARK_MESH_DIR "/*.off\n"
+    "  --points N                points per cloud (default 30000)\n"
+    "  --noise a,b,...           noise levels, x bbox diagonal (default 0,0.001,0.005)\n"
+    "  --seed S                  seed of the clouds and of QPBO-I (default 1)\n"
+    "  --orders N                random orders of QPBO-I (default 3)\n"
+    "  --threads T               maximum threads of orient_normals (default 0: all)\n"
+    "Orients copies of each cloud with Mst_solver(0) (paper MST), Mst_solver() (MST + 3 sweeps)\n"
+    "and Qpbo_i_solver(orders, seed) on the same graph and prints a Markdown table.\n"
+    "Exit status: 0 on success, 1 on a runtime error, 2 on usage errors.\n");
+}
+
+/// Parses a comma-separated list of noise levels in [0, 1); returns false on a bad entry.
+bool parse_noise_list(const std::string& text, std::vector<double>& values)
+{
+  values.clear();
+  std::size_t begin = 0;
+  while(begin <= text.size())
+  {
+    std::size_t end = text.find(',', begin);
+    if(end == std::string::npos)
+      end = text.size();
+    const std::string item = text.substr(begin, end - begin);
+    char* stop = nullptr;
+    const double value = std::strtod(item.c_str(), &stop);
+    if(item.empty() || *stop != '\0' || !(value >= 0.0) || !(value < 1.0))
+      return false;
+    values.push_back(value);
+    begin = end + 1;
+  }
+  return !values.empty();
+}
+
+/// Parses the unsigned decimal `text` into `value`; returns false unless it lies in [minimum, maximum].
+bool parse_unsigned(const char* text, unsigned long long minimum, unsigned long long maximum,
+                    unsigned long long& value)
+{
+  char* stop = nullptr;
+  value = std::strtoull(text, &stop, 10);
+  return text[0] != '-' && stop != text && *stop == '\0' && value >= minimum && value <= maximum;
+}
+
+/// Parses the command line into `options`; returns false (after printing why) on an error.
+bool parse_options(int argc, char** argv, Options& options, bool& help)
+{
+  help = false;
+  for(int i = 1; i < argc; ++i)
+  {
+    const std::string arg = argv[i];
+    const bool has_value = i + 1 < argc;
+    unsigned long long value = 0;
+    if(arg == "-h" || arg == "--help")
+    {
+      help = true;
+      return true;
+    }
+    else if(arg == "--meshes")
+    {
+      while(i + 1 < argc && std::strncmp(argv[i + 1], "--", 2) != 0)
+        options.mesh_arguments.push_back(argv[++i]);
+      if(options.mesh_arguments.empty())
+      {
+        std::fprintf(stderr, "solver_quality: --meshes needs at least one file or directory\n");
+        return false;
+      }
+    }
+    else if(arg == "--points" && has_value)
+    {
+      if(!parse_unsigned(argv[++i], 1, static_cast<unsigned long long>(SIZE_MAX), value))
+      {
+        std::fprintf(stderr, "solver_quality: invalid --points '%s'\n", argv[i]);
+        return false;
+      }
+      options.points = static_cast<std::size_t>(value);
+    }
+    else if(arg == "--noise" && has_value)
+    {
+      if(!parse_noise_list(argv[++i], options.noises))
+      {
+        std::fprintf(stderr, "solver_quality: invalid --noise '%s' (expected e.g. 0,0.001,0.005)\n", argv[i]);
+        return false;
+      }
+    }
+    else if(arg == "--seed" && has_value)
+    {
+      if(!parse_unsigned(argv[++i], 0, UINT64_MAX, value))
+      {
+        std::fprintf(stderr, "solver_quality: invalid --seed '%s'\n", argv[i]);
+        return false;
+      }
+      options.seed = static_cast<std::uint64_t>(value);
+    }
+    else if(arg == "--orders" && has_value)
+    {
+      if(!parse_unsigned(argv[++i], 1, 100000, value))
+      {
+        std::fprintf(stderr, "solver_quality: invalid --orders '%s' (1..100000)\n", argv[i]);
+        return false;
+      }
+      options.orders = static_cast<unsigned int>(value);
+    }
+    else if(arg == "--threads" && has_value)
+    {
+      if(!parse_unsigned(argv[++i], 0, 4096, value))
+      {
+        std::fprintf(stderr, "solver_quality: invalid --threads '%s' (0..4096, 0 = all)\n", argv[i]);
+        return false;
+      }
+      options.threads = static_cast<int>(value);
+    }
+    else
+    {
+      std::fprintf(stderr, "solver_quality: unknown or incomplete option '%s'\n", arg.c_str());
+      return false;
+    }
+  }
+  return true;
+}
+
+/// Expands the --meshes arguments (or the default directory) into a list of mesh files.
+/// \throws std::runtime_error with a clear message when nothing usable is found.
+std::vector<std::string> collect_meshes(const std::vector<std::string>& arguments)
+{
+  std::vector<std::string> inputs = arguments;
+  if(inputs.empty())
+  {
+    std::error_code ec;
+    if(!fs::is_directory(NORMAL_ORIENTATION_BENCHMARK_MESH_DIR, ec))
+      throw std::runtime_error("the default mesh directory '" NORMAL_ORIENTATION_BENCHMARK_MESH_DIR
+                               "' does not exist; pass --meshes DIR_OR_FILES...");
+    inputs.push_back(NORMAL_ORIENTATION_BENCHMARK_MESH_DIR);
+  }
+  std::vector<std::string> meshes;
+  for(const std::string& input : inputs)
+  {
+    std::error_code ec;
+    if(fs::is_directory(input, ec))
+    {
+      std::vector<std::string> found;
+      for(const fs::directory_entry& entry : fs::directory_iterator(input, ec))
+        if(entry.is_regular_file() && entry.path().extension() == ".off")
+          found.push_back(entry.path().string());
+      if(found.empty())
+        throw std::runtime_error("no .off file in directory '" + input + "'");
+      std::sort(found.begin(), found.end());
+      meshes.insert(meshes.end(), found.begin(), found.end());
+    }
+    else if(fs::is_regular_file(input, ec))
+      meshes.push_back(input);
+    else
+      throw std::runtime_error("mesh '" + input + "' is neither a file nor a directory");
+  }
+  return meshes;
+}
+
+/// A point with its (to be oriented) normal.
+using Point_with_normal = std::pair<Point_3, Vector_3>;
+
+/**
+ * \brief Orients a copy of the normals of `cloud` with `solver` and scores the result.
+ *
+ * The energy and the solve time are those reported by `orient_normals()`; a normal is wrong
+ * when its dot product with the true normal is not strictly positive.
+ * \param number_of_edges receives the number of edges of the graph (to check that every
+ *   solver saw the same graph).
+ * \throws std::runtime_error if the run was interrupted or changed the number of points.
+ */
+template <typename Solver>
+Solver_row run_solver(const Sampled_cloud& cloud, const Solver& solver, int threads, std::size_t& number_of_edges)
+{
+  std::vector<Point_with_normal> points;
+  points.reserve(cloud.points.size());
+  for(std::size_t i = 0; i < cloud.points.size(); ++i)
+    points.emplace_back(cloud.points[i], cloud.normals[i]);
+
+  namespace NP = Normal_orientation::parameters;
+  const Normal_orientation::Orientation_result result = Normal_orientation::orient_normals(
+    points, NP::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
+              .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>())
+              .solver(solver)
+              .number_of_threads(threads));
+  if(result.interrupted || result.number_of_points != cloud.points.size())
+    throw std::runtime_error("orient_normals did not complete");
+
+  Solver_row row;
+  row.energy = result.energy_after;
+  row.solve_seconds = result.seconds.solve;
+  for(std::size_t i = 0; i < points.size(); ++i)
+    if(!(points[i].second * cloud.true_normals[i] > 0.0))
+      ++row.wrong;
+  number_of_edges = result.number_of_edges;
+  return row;
+}
+
+/// Returns the energy reduction of `energy` relative to `reference`, in percent (0 when the reference is 0).
+double reduction_percent(double reference, double energy)
+{
+  return reference > 0.0 ? 100.0 * (reference - energy) / reference : 0.0;
+}
+
+/// Prints the header of the Markdown table.
+void print_header()
+{
+  std::printf("| mesh | noise | points |");
+  for(const char* label : solver_labels)
+    std::printf(" E %s |", label);
+  std::printf(" red. %s | red. %s |", solver_labels[1], solver_labels[2]);
+  for(const char* label : solver_labels)
+    std::printf(" wrong %s |", label);
+  for(const char* label : solver_labels)
+    std::printf(" solve s %s |", label);
+  std::printf("\n|---|---:|---:|");
+  for(std::size_t c = 0; c < 2 * number_of_solvers + 2 + number_of_solvers; ++c)
+    std::printf("---:|");
+  std::printf("\n");
+}
+
+/// Prints one line of the table; `mesh` and `noise` are already formatted.
+void print_line(const std::string& mesh, const std::string& noise, std::size_t points,
+                const std::array<Solver_row, number_of_solvers>& solvers)
+{
+  std::printf("| %s | %s | %zu |", mesh.c_str(), noise.c_str(), points);
+  for(const Solver_row& s : solvers)
+    std::printf(" %.2f |", s.energy);
+  for(std::size_t s = 1; s < number_of_solvers; ++s)
+    std::printf(" %.2f%% |", reduction_percent(solvers[0].energy, solvers[s].energy));
+  for(const Solver_row& s : solvers)
+    std::printf(" %zu (%.2f%%) |", s.wrong, points > 0 ? 100.0 * double(s.wrong) / double(points) : 0.0);
+  for(const Solver_row& s : solvers)
+    std::printf(" %.3f |", s.solve_seconds);
+  std::printf("\n");
+  std::fflush(stdout);
+}
+
+} // namespace
+
+/// Entry point: parses the options, runs every cloud and prints the table.
+int main(int argc, char** argv)
+{
+  Options options;
+  bool help = false;
+  if(!parse_options(argc, argv, options, help))
+  {
+    print_usage(stderr);
+    return 2;
+  }
+  if(help)
+  {
+    print_usage(stdout);
+    return 0;
+  }
+
+  try
+  {
+    const std::vector<std::string> meshes = collect_meshes(options.mesh_arguments);
+    std::printf("solver_quality: %zu mesh(es), %zu points, seed %llu, QPBO-I orders %u, threads %d "
+                "(same graph, default k and radius, for every solver)\n\n",
+                meshes.size(), options.points, static_cast<unsigned long long>(options.seed), options.orders,
+                options.threads);
+    print_header();
+
+    const Normal_orientation::Mst_solver paper_mst(0);
+    const Normal_orientation::Mst_solver default_mst;
+    const Normal_orientation::Qpbo_i_solver qpbo_i(options.orders, static_cast<unsigned long>(options.seed));
+
+    std::array<Solver_row, number_of_solvers> totals;
+    std::size_t total_points = 0;
+    for(const std::string& mesh : meshes)
+    {
+      const Mesh_sampler sampler(mesh);
+      for(double noise : options.noises)
+      {
+        Sampling_options sampling;
+        sampling.number_of_points = options.points;
+        sampling.noise = noise;
+        sampling.seed = options.seed;
+        const Sampled_cloud cloud = sampler.sample(sampling);
+
+        Table_row row;
+        row.mesh = fs::path(mesh).filename().string();
+        row.noise = noise;
+        row.points = cloud.points.size();
+        std::array<std::size_t, number_of_solvers> edges{};
+        row.solvers[0] = run_solver(cloud, paper_mst, options.threads, edges[0]);
+        row.solvers[1] = run_solver(cloud, default_mst, options.threads, edges[1]);
+        row.solvers[2] = run_solver(cloud, qpbo_i, options.threads, edges[2]);
+        if(edges[1] != edges[0] || edges[2] != edges[0])
+          throw std::runtime_error("the solvers did not see the same graph on '" + row.mesh + "'");
+
+        char noise_text[32];
+        std::snprintf(noise_text, sizeof(noise_text), "%g", noise);
+        print_line(row.mesh, noise_text, row.points, row.solvers);
+        for(std::size_t s = 0; s < number_of_solvers; ++s)
+        {
+          totals[s].energy += row.solvers[s].energy;
+          totals[s].wrong += row.solvers[s].wrong;
+          totals[s].solve_seconds += row.solvers[s].solve_seconds;
+        }
+        total_points += row.points;
+      }
+    }
+    print_line("**total**", "", total_points, totals);
+  }
+  catch(const std::exception& e)
+  {
+    std::fprintf(stderr, "solver_quality: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
