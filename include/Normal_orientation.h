@@ -14,6 +14,7 @@
 #include <Normal_orientation/orient_normals.h>
 #include <Normal_orientation/parameters.h>
 #include <Normal_orientation/solvers/Exhaustive_solver.h>
+#include <Normal_orientation/solvers/Lsa_tr_solver.h>
 #include <Normal_orientation/solvers/Mst_solver.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
 
