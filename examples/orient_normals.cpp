@@ -10,6 +10,7 @@
 
 #include <Normal_orientation/IO/Point_cloud_io.h>
 #include <Normal_orientation/orient_normals.h>
+#include <Normal_orientation/solvers/Lsa_tr_solver.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -108,7 +109,7 @@ const char* usage_text =
   "  --k N                neighbours per point (default 12)\n"
   "  --radius R           neighbour radius (default: estimated from the data)\n"
   "  --criterion NAME     flip criterion: hoppe (default), xie, konig\n"
-  "  --solver NAME        solver: mst (default), qpbo-i (slower, lower energy)\n"
+  "  --solver NAME        solver: mst (default), qpbo-i, lsa-tr (lower energy, slower)\n"
   "  --orders N           qpbo-i: random orders tried, the best is kept (default 3)\n"
   "  --sign NAME          component sign: outward (default), keep\n"
   "  --viewpoint X,Y,Z    make every component face this point instead\n"
@@ -160,8 +161,8 @@ Options parse_options(int argc, char** argv)
         throw Usage_error("unknown criterion '" + o.criterion + "' (hoppe, xie, konig)");
     } else if (a == "--solver") {
       o.solver = value();
-      if (o.solver != "mst" && o.solver != "qpbo-i")
-        throw Usage_error("unknown solver '" + o.solver + "' (mst, qpbo-i)");
+      if (o.solver != "mst" && o.solver != "qpbo-i" && o.solver != "lsa-tr")
+        throw Usage_error("unknown solver '" + o.solver + "' (mst, qpbo-i, lsa-tr)");
     } else if (a == "--orders") {
       const long n = parse_number<long>(a, value());
       if (n < 1 || n > 1000)
@@ -290,6 +291,8 @@ NO::Orientation_result run(Range& range, const Np& np, const Criterion& criterio
   if (o.solver == "qpbo-i")
     return NO::orient_normals(
       range, np.flip_criterion(criterion).component_sign(sign).solver(NO::Qpbo_i_solver(o.orders, o.seed)));
+  if (o.solver == "lsa-tr")
+    return NO::orient_normals(range, np.flip_criterion(criterion).component_sign(sign).solver(NO::Lsa_tr_solver()));
   return NO::orient_normals(range, np.flip_criterion(criterion).component_sign(sign));
 }
 

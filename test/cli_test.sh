@@ -52,6 +52,10 @@ expect_exit 0 "qpbo-i solver" "$prog" --quiet --json --solver qpbo-i --orders 2 
 check "json names the qpbo-i solver" grep -q '"solver": "qpbo-i"' "$dir/out.txt"
 check "qpbo-i normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/qpbo.xyz"
 
+expect_exit 0 "lsa-tr solver" "$prog" --quiet --json --solver lsa-tr "$dir/sphere.xyz" "$dir/lsa.xyz"
+check "json names the lsa-tr solver" grep -q '"solver": "lsa-tr"' "$dir/out.txt"
+check "lsa-tr normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/lsa.xyz"
+
 # points without normals: estimated first
 awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/bare.xyz"
 expect_exit 0 "estimates missing normals" "$prog" --quiet --normals pca "$dir/bare.xyz" "$dir/bare_out.xyz"
