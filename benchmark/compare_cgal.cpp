@@ -4,6 +4,7 @@
 // For each mesh and each noise level, generates a cloud in process (Mesh_sampler.h), runs
 // both programs as child processes (wall-clock time, peak RSS from wait4), counts the wrong
 // normals of each against the ground truth and prints a Markdown table. See README.md.
+#include "Benchmark_options.h"
 #include "Mesh_sampler.h"
 #include "Xyz_io.h"
 
@@ -54,16 +55,9 @@ using namespace Normal_orientation::benchmark;
 // ---------------------------------------------------------------------------------------
 
 /// Command-line options of compare_cgal.
-struct Options
+struct Options : Cloud_options
 {
-  /// Mesh files and directories given with --meshes (empty: the default directory).
-  std::vector<std::string> mesh_arguments;
-  /// Points per cloud.
-  std::size_t points = 30000;
-  /// Noise levels (fractions of the bounding-box diagonal).
-  std::vector<double> noises = {0.0, 0.005};
-  /// Seed of every cloud.
-  std::uint64_t seed = 1;
+  Options() { noises = {0.0, 0.005}; }
   /// Our orientation program.
   std::string ours = NORMAL_ORIENTATION_BENCHMARK_OURS;
   /// The peer program wrapping CGAL::mst_orient_normals.
@@ -112,26 +106,6 @@ std::vector<std::string> split_words(const std::string& text)
   return words;
 }
 
-/// Parses a comma-separated list of non-negative numbers; returns false on a bad entry.
-bool parse_noise_list(const std::string& text, std::vector<double>& values)
-{
-  values.clear();
-  std::size_t begin = 0;
-  while(begin <= text.size())
-  {
-    std::size_t end = text.find(',', begin);
-    if(end == std::string::npos)
-      end = text.size();
-    const std::string item = text.substr(begin, end - begin);
-    char* stop = nullptr;
-    const double value = std::strtod(item.c_str(), &stop);
-    if(item.empty() || *stop != '\0' || !(value >= 0.0) || !(value < 1.0))
-      return false;
-    values.push_back(value);
-    begin = end + 1;
-  }
-  return !values.empty();
-}
 
 /// Parses the command line into `options`; returns false (after printing why) on an error.
 bool parse_options(int argc, char** argv, Options& options, bool& help)
@@ -146,46 +120,10 @@ bool parse_options(int argc, char** argv, Options& options, bool& help)
       help = true;
       return true;
     }
-    else if(arg == "--meshes")
+    else if(const int parsed = parse_cloud_option(argc, argv, i, options, "compare_cgal"))
     {
-      while(i + 1 < argc && std::strncmp(argv[i + 1], "--", 2) != 0)
-        options.mesh_arguments.push_back(argv[++i]);
-      if(options.mesh_arguments.empty())
-      {
-        std::fprintf(stderr, "compare_cgal: --meshes needs at least one file or directory\n");
+      if(parsed < 0)
         return false;
-      }
-    }
-    else if(arg == "--points" && has_value)
-    {
-      char* stop = nullptr;
-      const char* text = argv[++i];
-      const unsigned long long value = std::strtoull(text, &stop, 10);
-      if(text[0] == '-' || stop == text || *stop != '\0' || value == 0)
-      {
-        std::fprintf(stderr, "compare_cgal: invalid --points '%s'\n", text);
-        return false;
-      }
-      options.points = static_cast<std::size_t>(value);
-    }
-    else if(arg == "--noise" && has_value)
-    {
-      if(!parse_noise_list(argv[++i], options.noises))
-      {
-        std::fprintf(stderr, "compare_cgal: invalid --noise '%s' (expected e.g. 0,0.005)\n", argv[i]);
-        return false;
-      }
-    }
-    else if(arg == "--seed" && has_value)
-    {
-      char* stop = nullptr;
-      const char* text = argv[++i];
-      options.seed = std::strtoull(text, &stop, 10);
-      if(text[0] == '-' || stop == text || *stop != '\0')
-      {
-        std::fprintf(stderr, "compare_cgal: invalid --seed '%s'\n", text);
-        return false;
-      }
     }
     else if(arg == "--ours" && has_value)
       options.ours = argv[++i];
@@ -218,41 +156,6 @@ bool parse_options(int argc, char** argv, Options& options, bool& help)
   return true;
 }
 
-/// Expands the --meshes arguments (or the default directory) into a list of mesh files.
-/// \throws std::runtime_error with a clear message when nothing usable is found.
-std::vector<std::string> collect_meshes(const std::vector<std::string>& arguments)
-{
-  std::vector<std::string> inputs = arguments;
-  if(inputs.empty())
-  {
-    std::error_code ec;
-    if(!fs::is_directory(NORMAL_ORIENTATION_BENCHMARK_MESH_DIR, ec))
-      throw std::runtime_error("the default mesh directory '" NORMAL_ORIENTATION_BENCHMARK_MESH_DIR
-                               "' does not exist; pass --meshes DIR_OR_FILES...");
-    inputs.push_back(NORMAL_ORIENTATION_BENCHMARK_MESH_DIR);
-  }
-  std::vector<std::string> meshes;
-  for(const std::string& input : inputs)
-  {
-    std::error_code ec;
-    if(fs::is_directory(input, ec))
-    {
-      std::vector<std::string> found;
-      for(const fs::directory_entry& entry : fs::directory_iterator(input, ec))
-        if(entry.is_regular_file() && entry.path().extension() == ".off")
-          found.push_back(entry.path().string());
-      if(found.empty())
-        throw std::runtime_error("no .off file in directory '" + input + "'");
-      std::sort(found.begin(), found.end());
-      meshes.insert(meshes.end(), found.begin(), found.end());
-    }
-    else if(fs::is_regular_file(input, ec))
-      meshes.push_back(input);
-    else
-      throw std::runtime_error("mesh '" + input + "' is neither a file nor a directory");
-  }
-  return meshes;
-}
 
 // ---------------------------------------------------------------------------------------
 // Child processes

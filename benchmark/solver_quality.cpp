@@ -7,6 +7,7 @@
 // our default (MST + 3 local sweeps), and (c) Qpbo_i_solver(orders, seed), MST + QPBO-I.
 // Every other parameter is at its default, so the three runs build the same graph.
 // Prints a Markdown table. See README.md.
+#include "Benchmark_options.h"
 #include "Mesh_sampler.h"
 
 #include <Normal_orientation/orient_normals.h>
@@ -44,17 +45,10 @@ constexpr std::size_t number_of_solvers = 3;
 /// Column labels of the compared solvers, in table order.
 const std::array<const char*, number_of_solvers> solver_labels = {"MST", "MST+sweeps", "QPBO-I"};
 
-/// Command-line options of solver_quality.
-struct Options
+/// Command-line options of solver_quality (the seed also seeds the QPBO-I orders).
+struct Options : Cloud_options
 {
-  /// Mesh files and directories given with --meshes (empty: the default directory).
-  std::vector<std::string> mesh_arguments;
-  /// Points per cloud.
-  std::size_t points = 30000;
-  /// Noise levels (fractions of the bounding-box diagonal).
-  std::vector<double> noises = {0.0, 0.001, 0.005};
-  /// Seed of every cloud and of the QPBO-I orders.
-  std::uint64_t seed = 1;
+  Options() { noises = {0.0, 0.001, 0.005}; }
   /// Random orders tried by QPBO-I.
   unsigned int orders = 3;
   /// Maximum number of threads of orient_normals (0: all).
@@ -103,35 +97,7 @@ void print_usage(std::FILE* out)
     "Exit status: 0 on success, 1 on a runtime error, 2 on usage errors.\n");
 }
 
-/// Parses a comma-separated list of noise levels in [0, 1); returns false on a bad entry.
-bool parse_noise_list(const std::string& text, std::vector<double>& values)
-{
-  values.clear();
-  std::size_t begin = 0;
-  while(begin <= text.size())
-  {
-    std::size_t end = text.find(',', begin);
-    if(end == std::string::npos)
-      end = text.size();
-    const std::string item = text.substr(begin, end - begin);
-    char* stop = nullptr;
-    const double value = std::strtod(item.c_str(), &stop);
-    if(item.empty() || *stop != '\0' || !(value >= 0.0) || !(value < 1.0))
-      return false;
-    values.push_back(value);
-    begin = end + 1;
-  }
-  return !values.empty();
-}
 
-/// Parses the unsigned decimal `text` into `value`; returns false unless it lies in [minimum, maximum].
-bool parse_unsigned(const char* text, unsigned long long minimum, unsigned long long maximum,
-                    unsigned long long& value)
-{
-  char* stop = nullptr;
-  value = std::strtoull(text, &stop, 10);
-  return text[0] != '-' && stop != text && *stop == '\0' && value >= minimum && value <= maximum;
-}
 
 /// Parses the command line into `options`; returns false (after printing why) on an error.
 bool parse_options(int argc, char** argv, Options& options, bool& help)
@@ -147,41 +113,10 @@ bool parse_options(int argc, char** argv, Options& options, bool& help)
       help = true;
       return true;
     }
-    else if(arg == "--meshes")
+    else if(const int parsed = parse_cloud_option(argc, argv, i, options, "solver_quality"))
     {
-      while(i + 1 < argc && std::strncmp(argv[i + 1], "--", 2) != 0)
-        options.mesh_arguments.push_back(argv[++i]);
-      if(options.mesh_arguments.empty())
-      {
-        std::fprintf(stderr, "solver_quality: --meshes needs at least one file or directory\n");
+      if(parsed < 0)
         return false;
-      }
-    }
-    else if(arg == "--points" && has_value)
-    {
-      if(!parse_unsigned(argv[++i], 1, static_cast<unsigned long long>(SIZE_MAX), value))
-      {
-        std::fprintf(stderr, "solver_quality: invalid --points '%s'\n", argv[i]);
-        return false;
-      }
-      options.points = static_cast<std::size_t>(value);
-    }
-    else if(arg == "--noise" && has_value)
-    {
-      if(!parse_noise_list(argv[++i], options.noises))
-      {
-        std::fprintf(stderr, "solver_quality: invalid --noise '%s' (expected e.g. 0,0.001,0.005)\n", argv[i]);
-        return false;
-      }
-    }
-    else if(arg == "--seed" && has_value)
-    {
-      if(!parse_unsigned(argv[++i], 0, UINT64_MAX, value))
-      {
-        std::fprintf(stderr, "solver_quality: invalid --seed '%s'\n", argv[i]);
-        return false;
-      }
-      options.seed = static_cast<std::uint64_t>(value);
     }
     else if(arg == "--orders" && has_value)
     {
@@ -210,41 +145,6 @@ bool parse_options(int argc, char** argv, Options& options, bool& help)
   return true;
 }
 
-/// Expands the --meshes arguments (or the default directory) into a list of mesh files.
-/// \throws std::runtime_error with a clear message when nothing usable is found.
-std::vector<std::string> collect_meshes(const std::vector<std::string>& arguments)
-{
-  std::vector<std::string> inputs = arguments;
-  if(inputs.empty())
-  {
-    std::error_code ec;
-    if(!fs::is_directory(NORMAL_ORIENTATION_BENCHMARK_MESH_DIR, ec))
-      throw std::runtime_error("the default mesh directory '" NORMAL_ORIENTATION_BENCHMARK_MESH_DIR
-                               "' does not exist; pass --meshes DIR_OR_FILES...");
-    inputs.push_back(NORMAL_ORIENTATION_BENCHMARK_MESH_DIR);
-  }
-  std::vector<std::string> meshes;
-  for(const std::string& input : inputs)
-  {
-    std::error_code ec;
-    if(fs::is_directory(input, ec))
-    {
-      std::vector<std::string> found;
-      for(const fs::directory_entry& entry : fs::directory_iterator(input, ec))
-        if(entry.is_regular_file() && entry.path().extension() == ".off")
-          found.push_back(entry.path().string());
-      if(found.empty())
-        throw std::runtime_error("no .off file in directory '" + input + "'");
-      std::sort(found.begin(), found.end());
-      meshes.insert(meshes.end(), found.begin(), found.end());
-    }
-    else if(fs::is_regular_file(input, ec))
-      meshes.push_back(input);
-    else
-      throw std::runtime_error("mesh '" + input + "' is neither a file nor a directory");
-  }
-  return meshes;
-}
 
 /// A point with its (to be oriented) normal.
 using Point_with_normal = std::pair<Point_3, Vector_3>;

@@ -22,6 +22,7 @@
 #include <boost/property_map/property_map.hpp>
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace Normal_orientation {
@@ -89,6 +90,34 @@ std::size_t connected_components(const Graph& g, WeightMap weight, std::vector<s
   }
   return count;
 }
+
+/// \cond SKIP_IN_MANUAL
+namespace internal {
+
+/// Writes `best` (one label per vertex index) to `labels`; returns the
+/// energy of `best` and the number of edges whose wish it does not meet.
+template <typename Graph, typename WeightMap, typename LabelMap>
+std::pair<double, std::size_t> write_labels(const Graph& g, WeightMap weight, const std::vector<Label>& best,
+                                            LabelMap labels)
+{
+  auto index = get(boost::vertex_index, g);
+  typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
+  for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit)
+    put(labels, *vit, best[std::size_t(get(index, *vit))]);
+  double e = 0.0;
+  std::size_t frustrated = 0;
+  typename boost::graph_traits<Graph>::edge_iterator it, end;
+  for (boost::tie(it, end) = edges(g); it != end; ++it) {
+    const double term = edge_energy(double(get(weight, *it)), best[std::size_t(get(index, source(*it, g)))],
+                                    best[std::size_t(get(index, target(*it, g)))]);
+    e += term;
+    frustrated += term > 0.0 ? 1 : 0;
+  }
+  return {e, frustrated};
+}
+
+} // namespace internal
+/// \endcond
 
 } // namespace Normal_orientation
 

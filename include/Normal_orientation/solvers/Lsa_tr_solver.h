@@ -20,6 +20,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <tuple>
 #include <vector>
 
 namespace Normal_orientation {
@@ -248,14 +249,7 @@ public:
     std::vector<Label> best(n);
     for (std::size_t i = 0; i < n; ++i)
       best[i] = z[i] ? Label(-y[i]) : y[i];
-    typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
-    for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit)
-      put(labels, *vit, best[std::size_t(get(index, *vit))]);
-    report.energy = energy(g, weight, boost::make_iterator_property_map(best.cbegin(), index));
-    for (boost::tie(it, end) = edges(g); it != end; ++it)
-      if (edge_energy(double(get(weight, *it)), best[std::size_t(get(index, source(*it, g)))],
-                      best[std::size_t(get(index, target(*it, g)))]) > 0.0)
-        ++report.frustrated_edges;
+    std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, best, labels);
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;
   }

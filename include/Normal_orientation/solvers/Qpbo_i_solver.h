@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cstdint>
 #include <random>
+#include <tuple>
 #include <vector>
 
 namespace Normal_orientation {
@@ -155,14 +156,7 @@ public:
       }
     }
 
-    typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
-    for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit)
-      put(labels, *vit, best[std::size_t(get(index, *vit))]);
-    report.energy = best_energy;
-    for (boost::tie(it, end) = edges(g); it != end; ++it)
-      if (edge_energy(double(get(weight, *it)), best[std::size_t(get(index, source(*it, g)))],
-                      best[std::size_t(get(index, target(*it, g)))]) > 0.0)
-        ++report.frustrated_edges;
+    std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, best, labels);
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;
   }
