@@ -89,6 +89,7 @@ struct Options
   std::string sign = "outward";
   bool has_viewpoint = false;
   double viewpoint[3] = {0, 0, 0};
+  double prior_weight = 0.0;
   std::string normals = "jet";
   unsigned int normal_k = 18;
   int threads = 0;
@@ -113,6 +114,9 @@ const char* usage_text =
   "  --orders N           qpbo-i: random orders tried, the best is kept (default 3)\n"
   "  --sign NAME          component sign: outward (default), keep\n"
   "  --viewpoint X,Y,Z    make every component face this point instead\n"
+  "  --prior-weight W     with --viewpoint: also a soft prior for every point to face\n"
+  "                       it, of weight W * cos(angle) (edges weigh at most 1), which\n"
+  "                       every solver weighs against the edges (default 0: none)\n"
   "  --normals NAME       estimator when IN has no normals: jet (default), pca\n"
   "  --normal-k N         neighbours of the normal estimator (default 18)\n"
   "  --threads N          threads (default: all cores); results do not depend on it\n"
@@ -182,6 +186,10 @@ Options parse_options(int argc, char** argv)
           !std::isfinite(o.viewpoint[0] + o.viewpoint[1] + o.viewpoint[2]))
         throw Usage_error("--viewpoint needs X,Y,Z");
       o.has_viewpoint = true;
+    } else if (a == "--prior-weight") {
+      o.prior_weight = parse_number<double>(a, value());
+      if (!(o.prior_weight >= 0.0 && o.prior_weight <= 1e6))
+        throw Usage_error("--prior-weight must be between 0 and 1e6");
     } else if (a == "--normals") {
       o.normals = value();
       if (o.normals != "jet" && o.normals != "pca")
@@ -212,6 +220,8 @@ Options parse_options(int argc, char** argv)
   }
   if (positional.size() > 2)
     throw Usage_error("too many arguments");
+  if (o.prior_weight > 0.0 && !o.has_viewpoint)
+    throw Usage_error("--prior-weight needs --viewpoint");
   if (positional.empty()) {
     o.input = NORMAL_ORIENTATION_SAMPLE_CLOUD;
     o.output = "sample_oriented.ply";
@@ -297,12 +307,15 @@ NO::Orientation_result run(Range& range, const Np& np, const Criterion& criterio
 }
 
 template <typename Range, typename Np>
-NO::Orientation_result run_with_criterion(Range& range, const Np& np, const Options& o)
+NO::Orientation_result run_with_criterion(Range& range, const Np& np, const Options& o, std::vector<double>& prior)
 {
   auto with_sign = [&](const auto& criterion) {
-    if (o.has_viewpoint)
-      return run(range, np, criterion, NO::Viewpoint_component_sign(o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]),
-                 o);
+    if (o.has_viewpoint) {
+      const NO::Viewpoint_component_sign towards(o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]);
+      if (!prior.empty())
+        return run(range, np.orientation_prior_map(CGAL::make_property_map(prior)), criterion, towards, o);
+      return run(range, np, criterion, towards, o);
+    }
     if (o.sign == "keep")
       return run(range, np, criterion, NO::Keep_component_sign(), o);
     return run(range, np, criterion, NO::Outward_component_sign(), o);
@@ -363,7 +376,23 @@ int main_impl(int argc, char** argv)
               .number_of_threads(o.threads)
               .random_seed(o.seed)
               .callback(callback);
-  const NO::Orientation_result r = run_with_criterion(range, np, o);
+  // The viewpoint prior: a_i = W cos(angle between n_i and p_i -> viewpoint).
+  std::vector<double> prior;
+  if (o.prior_weight > 0.0) {
+    prior.resize(cloud.size(), 0.0);
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      double to[3], dot = 0.0, lt = 0.0, ln = 0.0;
+      for (int d = 0; d < 3; ++d) {
+        to[d] = o.viewpoint[d] - cloud.points[i][d];
+        dot += to[d] * cloud.normals[i][d];
+        lt += to[d] * to[d];
+        ln += cloud.normals[i][d] * cloud.normals[i][d];
+      }
+      if (lt > 0.0 && ln > 0.0)
+        prior[i] = o.prior_weight * dot / std::sqrt(lt * ln);
+    }
+  }
+  const NO::Orientation_result r = run_with_criterion(range, np, o, prior);
   bar.finish();
 
   const auto tw = std::chrono::steady_clock::now();
@@ -393,7 +422,8 @@ int main_impl(int argc, char** argv)
     std::printf("{\"input\": \"%s\", \"output\": \"%s\", \"points\": %zu, \"edges\": %zu, \"components\": %zu, "
                 "\"k\": %u, \"radius\": %.9g, \"radius_estimated\": %s, \"criterion\": \"%s\", \"solver\": \"%s\", "
                 "\"component_sign\": \"%s\", \"seed\": %lu, \"threads\": %d, \"normals_estimated\": %s, "
-                "\"energy_before\": %.9g, \"energy_after\": %.9g, \"frustrated_edges\": %zu, \"flipped\": %zu, "
+                "\"energy_before\": %.9g, \"energy_after\": %.9g, \"frustrated_edges\": %zu, \"segments\": %zu, "
+                "\"unary_terms\": %zu, \"flipped\": %zu, "
                 "\"zero_normals\": %zu, \"seconds\": {\"read\": %.6f, \"estimate_normals\": %.6f, "
                 "\"neighbors\": %.6f, \"graph\": %.6f, \"solve\": %.6f, \"sign\": %.6f, \"orient_total\": %.6f, "
                 "\"write\": %.6f, \"total\": %.6f}}\n",
@@ -401,7 +431,7 @@ int main_impl(int argc, char** argv)
                 r.number_of_components, r.number_of_neighbors, r.neighbor_radius,
                 r.radius_estimated ? "true" : "false", r.criterion.c_str(), r.solver.c_str(),
                 r.component_sign.c_str(), o.seed, o.threads, estimated ? "true" : "false", r.energy_before,
-                r.energy_after, r.frustrated_edges, r.number_of_flipped, r.number_of_zero_normals, read_seconds,
+                r.energy_after, r.frustrated_edges, r.number_of_segments, r.number_of_unary_terms, r.number_of_flipped, r.number_of_zero_normals, read_seconds,
                 estimate_seconds, r.seconds.neighbors, r.seconds.graph, r.seconds.solve, r.seconds.sign,
                 r.seconds.total, write_seconds, total_seconds);
   }

@@ -56,13 +56,22 @@ expect_exit 0 "lsa-tr solver" "$prog" --quiet --json --solver lsa-tr "$dir/spher
 check "json names the lsa-tr solver" grep -q '"solver": "lsa-tr"' "$dir/out.txt"
 check "lsa-tr normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/lsa.xyz"
 
+# a viewpoint prior from the centre: every solver turns the sphere inward
+for solver in mst qpbo-i lsa-tr; do
+  expect_exit 0 "viewpoint prior, $solver" "$prog" --quiet --json --solver $solver --viewpoint 0,0,0 --prior-weight 0.05 \
+    "$dir/sphere.xyz" "$dir/prior_$solver.xyz"
+  check "json counts the unary terms ($solver)" grep -q '"unary_terms": 600' "$dir/out.txt"
+  check "prior normals point inward ($solver)" awk '{ if ($1*$4 + $2*$5 + $3*$6 >= 0) bad++ } END { exit bad > 0 }' \
+    "$dir/prior_$solver.xyz"
+done
+
 # points without normals: estimated first
 awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/bare.xyz"
 expect_exit 0 "estimates missing normals" "$prog" --quiet --normals pca "$dir/bare.xyz" "$dir/bare_out.xyz"
 check "estimated normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/bare_out.xyz"
 
 # bad options: exit 2, one line on stderr, no output
-for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads 0" "--bogus" "--viewpoint 1,2"; do
+for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads 0" "--bogus" "--viewpoint 1,2" "--prior-weight 1" "--viewpoint 0,0,0 --prior-weight -1" "--viewpoint 0,0,0 --prior-weight nan"; do
   # shellcheck disable=SC2086
   expect_exit 2 "bad option $args" "$prog" $args "$dir/sphere.xyz" "$dir/bad_opt.xyz"
   check "one-line error for $args" test "$(wc -l < "$dir/err.txt")" -eq 1

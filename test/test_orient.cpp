@@ -6,6 +6,8 @@
 #include "Synthetic_shapes.h"
 
 #include <Normal_orientation/orient_normals.h>
+#include <Normal_orientation/solvers/Lsa_tr_solver.h>
+#include <Normal_orientation/solvers/Qpbo_i_solver.h>
 
 #include <CGAL/Polygon_mesh_processing/IO/polygon_mesh_io.h>
 #include <CGAL/Point_set_3.h>
@@ -14,7 +16,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
+#include <iostream>
+#include <limits>
 #include <random>
 
 namespace NO = Normal_orientation;
@@ -317,6 +322,104 @@ TEST(Orient_normals, ConstraintsAndViewpointDecideTheSign)
 
   NO::orient_normals(inward, pn_params().component_sign(NO::Viewpoint_component_sign(0, 0, 0)));
   EXPECT_EQ(count_wrong(truth, inward), inward.size());
+}
+
+namespace {
+
+/// a soft prior per point, by address
+struct Prior_map
+{
+  typedef PN key_type;
+  typedef double value_type;
+  typedef double reference;
+  typedef boost::readable_property_map_tag category;
+  const PN* base;
+  const std::vector<double>* prior;
+  friend double get(const Prior_map& m, const PN& x) { return (*m.prior)[std::size_t(&x - m.base)]; }
+};
+
+template <typename Solver>
+void check_constraints_and_priors(const Solver& solver, const char* name)
+{
+  SCOPED_TRACE(name);
+  std::mt19937_64 rng(21);
+  const auto truth = sphere(6000, rng);
+  const auto input = unoriented(truth, rng, 0.05);
+
+  // Constraints: three points declared correct while pointing inward; they
+  // are hard, so the whole sphere follows them, with every solver.
+  auto cloud = input;
+  std::vector<bool> fixed(cloud.size(), false);
+  for (std::size_t i : {17u, 2500u, 4999u}) {
+    cloud[i].second = -truth[i].n;
+    fixed[i] = true;
+  }
+  NO::Orientation_result r =
+    NO::orient_normals(cloud, pn_params().solver(solver).point_is_constrained_map(Is_fixed{cloud.data(), &fixed}));
+  EXPECT_EQ(r.number_of_unary_terms, 3u);
+  EXPECT_EQ(count_wrong(truth, cloud), cloud.size());
+
+  // Conflicting constraints: one inward, one outward; both are kept as given.
+  cloud = input;
+  cloud[17].second = -truth[17].n;
+  cloud[4999].second = truth[4999].n;
+  const Vector n17 = cloud[17].second, n4999 = cloud[4999].second;
+  std::fill(fixed.begin(), fixed.end(), false);
+  fixed[17] = fixed[4999] = true;
+  NO::orient_normals(cloud, pn_params().solver(solver).point_is_constrained_map(Is_fixed{cloud.data(), &fixed}));
+  EXPECT_EQ(cloud[17].second, n17);
+  EXPECT_EQ(cloud[4999].second, n4999);
+
+  // A viewpoint prior from the centre (lambda = 0.02 per point, cos of the
+  // angle to the direction towards the centre) turns the whole sphere
+  // inward, against the default outward sign policy; with the prior's sign
+  // reversed it comes out outward.
+  for (double lambda : {0.02, -0.02}) {
+    cloud = input;
+    std::vector<double> prior(cloud.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const Vector to_centre = Point(0, 0, 0) - cloud[i].first;
+      prior[i] = lambda * (cloud[i].second * to_centre) / std::sqrt(to_centre.squared_length() * cloud[i].second.squared_length());
+    }
+    r = NO::orient_normals(cloud, pn_params().solver(solver).orientation_prior_map(Prior_map{cloud.data(), &prior}));
+    EXPECT_EQ(r.number_of_unary_terms, cloud.size());
+    EXPECT_EQ(count_wrong(truth, cloud), lambda > 0 ? cloud.size() : 0u) << "lambda " << lambda;
+  }
+
+  // a non-finite prior is refused, and nothing changes
+  cloud = input;
+  std::vector<double> prior(cloud.size(), 0.0);
+  prior[3] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(NO::orient_normals(cloud, pn_params().solver(solver).orientation_prior_map(Prior_map{cloud.data(), &prior})),
+               std::invalid_argument);
+  EXPECT_EQ(cloud, input);
+}
+
+} // namespace
+
+TEST(Orient_normals, ConstraintsAndPriorsAreHonouredByEverySolver)
+{
+  check_constraints_and_priors(NO::Mst_solver(), "mst");
+  check_constraints_and_priors(NO::Qpbo_i_solver(), "qpbo-i");
+  check_constraints_and_priors(NO::Lsa_tr_solver(), "lsa-tr");
+}
+
+TEST(Orient_normals, QpboIReducesLargeCloudsAndNeverEndsAboveMst)
+{
+  std::mt19937_64 rng(4);
+  const auto truth = torus(20000, rng);
+  const auto input = unoriented(truth, rng, 0.8); // strong angular noise: many frustrated edges
+  auto a = input, b = input;
+  const NO::Orientation_result mst = NO::orient_normals(a, pn_params().solver(NO::Mst_solver()));
+  const NO::Orientation_result qpbo = NO::orient_normals(b, pn_params().solver(NO::Qpbo_i_solver()));
+  EXPECT_EQ(mst.number_of_segments, 0u);
+  EXPECT_GT(qpbo.number_of_segments, 0u);
+  EXPECT_LT(qpbo.number_of_segments, 20000u / 4);
+  EXPECT_LT(qpbo.energy_after, mst.energy_after);
+  EXPECT_LE(count_wrong(truth, b), count_wrong(truth, a));
+  std::cout << "[ info ] noisy torus: MST energy " << mst.energy_after << ", " << count_wrong(truth, a)
+            << " wrong; QPBO-I energy " << qpbo.energy_after << ", " << count_wrong(truth, b) << " wrong, "
+            << qpbo.number_of_segments << " segments\n";
 }
 
 TEST(Orient_normals, SharedMeshesWhenPresent)

@@ -21,7 +21,10 @@
 #include <boost/graph/properties.hpp>
 #include <boost/property_map/property_map.hpp>
 
+#include <cmath>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -56,6 +59,29 @@ double energy(const Graph& g, WeightMap weight, LabelMap labels)
     e += edge_energy(double(get(weight, *it)),
                      int(get(labels, source(*it, g))),
                      int(get(labels, target(*it, g))));
+  return e;
+}
+
+/// \ingroup PkgNormalOrientationProblem
+/// Returns the energy of the labelling `labels` with unary terms:
+/// E(L) = sum over the edges e = (i, j) of `edge_energy(w_e, L_i, L_j)`
+/// (the energy of `energy(g, weight, labels)`) plus, for every vertex i,
+/// `get(unary, i).first` if L_i = +1 and `get(unary, i).second` if L_i = -1.
+/// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph`
+/// \tparam WeightMap a readable edge property map with a floating value
+/// \tparam UnaryMap a readable vertex property map whose value has members
+///         `first` (the cost of label +1) and `second` (the cost of label
+///         -1) convertible to `double`, such as `std::pair<double, double>`
+/// \tparam LabelMap a readable vertex property map with values +1/-1
+template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
+double energy(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels)
+{
+  double e = energy(g, weight, labels);
+  typename boost::graph_traits<Graph>::vertex_iterator it, end;
+  for (boost::tie(it, end) = vertices(g); it != end; ++it) {
+    const auto& costs = get(unary, *it);
+    e += int(get(labels, *it)) > 0 ? double(costs.first) : double(costs.second);
+  }
   return e;
 }
 
@@ -114,6 +140,47 @@ std::pair<double, std::size_t> write_labels(const Graph& g, WeightMap weight, co
     frustrated += term > 0.0 ? 1 : 0;
   }
   return {e, frustrated};
+}
+
+/// Writes `best` (one label per vertex index) to `labels`; returns the
+/// energy of `best` with the unary terms `unary` (the value of
+/// `energy(g, weight, unary, labels)`, summed in the same order) and the
+/// number of edges whose wish it does not meet.
+template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
+std::pair<double, std::size_t> write_labels(const Graph& g, WeightMap weight, UnaryMap unary,
+                                            const std::vector<Label>& best, LabelMap labels)
+{
+  std::pair<double, std::size_t> result = write_labels(g, weight, best, labels);
+  auto index = get(boost::vertex_index, g);
+  typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
+  for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit) {
+    const auto& costs = get(unary, *vit);
+    result.first += best[std::size_t(get(index, *vit))] > 0 ? double(costs.first) : double(costs.second);
+  }
+  return result;
+}
+
+/// The tag that stands for "no unary terms" in the solvers' implementations.
+struct No_unary
+{};
+
+/// Returns the unary costs of `unary` by vertex index: `first` the cost of
+/// label +1, `second` the cost of label -1.
+/// \throw std::invalid_argument (naming `solver`) if a cost is not finite
+template <typename Graph, typename UnaryMap>
+std::vector<std::pair<double, double>> unary_costs(const Graph& g, UnaryMap unary, const char* solver)
+{
+  std::vector<std::pair<double, double>> costs(std::size_t(num_vertices(g)), std::pair<double, double>(0.0, 0.0));
+  auto index = get(boost::vertex_index, g);
+  typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
+  for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit) {
+    const auto& c = get(unary, *vit);
+    const double plus = double(c.first), minus = double(c.second);
+    if (!std::isfinite(plus) || !std::isfinite(minus))
+      throw std::invalid_argument(std::string(solver) + ": a unary cost is not finite");
+    costs[std::size_t(get(index, *vit))] = {plus, minus};
+  }
+  return costs;
 }
 
 } // namespace internal

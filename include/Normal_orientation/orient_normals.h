@@ -64,6 +64,8 @@ struct Orientation_result
   double energy_before = 0.0;           ///< energy (eq. 3) of the input orientation
   double energy_after = 0.0;            ///< energy of the output orientation
   std::size_t frustrated_edges = 0;     ///< edges whose wish the output does not meet
+  std::size_t number_of_segments = 0;   ///< vertices of the segment graph the solver reduced to (0: none)
+  std::size_t number_of_unary_terms = 0; ///< points with a constraint or a non-zero prior
   std::string criterion;                ///< the flip criterion's name
   std::string solver;                   ///< the solver's name
   std::string component_sign;           ///< the component sign policy's name
@@ -78,6 +80,15 @@ template <typename T, typename = void>
 struct Has_name : std::false_type {};
 template <typename T>
 struct Has_name<T, std::void_t<decltype(T::name())>> : std::true_type {};
+
+/// true when `Solver` has the 4-argument solve(graph, weight, unary, labels)
+template <typename Solver, typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap, typename = void>
+struct Accepts_unary : std::false_type {};
+template <typename Solver, typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
+struct Accepts_unary<Solver, Graph, WeightMap, UnaryMap, LabelMap,
+                     std::void_t<decltype(std::declval<const Solver&>().solve(
+                       std::declval<const Graph&>(), std::declval<WeightMap>(), std::declval<UnaryMap>(),
+                       std::declval<LabelMap>()))>> : std::true_type {};
 
 template <typename T>
 std::string name_of(const T&)
@@ -172,9 +183,21 @@ void run_with_threads(int threads, const F& f)
 ///     \cgalParamDefault{`Outward_component_sign()`, or `Constrained_component_sign<>()` when `point_is_constrained_map` is given}
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{point_is_constrained_map}
-///     \cgalParamDescription{points whose input normal is known to be correctly oriented}
+///     \cgalParamDescription{points whose input normal is known to be correctly oriented: hard
+///       constraints, given to the solver as unary terms that outweigh all the edges together, so
+///       every solver keeps them; their components keep their sign}
 ///     \cgalParamType{a model of `ReadablePropertyMap` with value type `bool`}
 ///     \cgalParamDefault{no constrained point}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{orientation_prior_map}
+///     \cgalParamDescription{a soft prior per point (a `Normal_orientation::parameters` name): a value
+///       a > 0 favours keeping the input normal, a < 0 favours flipping it, with the weight |a| of an
+///       edge (edges weigh at most 1); 0 for no prior.  A viewpoint prior, for example, is
+///       a_i = lambda * cos(angle between n_i and the direction from p_i to the viewpoint).  The
+///       solver weighs priors against the edges; the components with a prior keep the sign the
+///       solver gave them}
+///     \cgalParamType{a model of `ReadablePropertyMap` with a floating value type}
+///     \cgalParamDefault{no prior}
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{callback}
 ///     \cgalParamDescription{called with the progress in [0, 1], from the calling thread; returning `false` interrupts the run}
@@ -195,7 +218,7 @@ void run_with_threads(int threads, const F& f)
 ///
 /// \return an `Orientation_result`
 /// \throw std::invalid_argument for k < 1, r <= 0, a negative thread
-///   count, or a non-finite coordinate or normal (the message names the point)
+///   count, or a non-finite coordinate, normal or prior (the message names the point)
 template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag, typename PointRange,
           typename NamedParameters = parameters::Default_named_parameters>
 Orientation_result orient_normals(PointRange& points, const NamedParameters& np = parameters::default_values())
@@ -223,6 +246,8 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
     choose_parameter(get_parameter(np, CGAL::internal_np::callback), std::function<bool(double)>());
   constexpr bool has_constraints =
     !CGAL::parameters::is_default_parameter<NamedParameters, CGAL::internal_np::point_is_constrained_t>::value;
+  constexpr bool has_prior =
+    !CGAL::parameters::is_default_parameter<NamedParameters, internal_np::orientation_prior_map_t>::value;
   typedef std::conditional_t<has_constraints, Constrained_component_sign<>, Outward_component_sign> Default_sign;
   const auto sign_policy = choose_parameter(get_parameter(np, internal_np::component_sign), Default_sign());
 
@@ -244,6 +269,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
   std::vector<Point> pts;
   std::vector<Vector> nrm;
   std::vector<char> constrained;
+  std::vector<double> prior;
   pts.reserve(n);
   nrm.reserve(n);
   {
@@ -274,6 +300,20 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       constrained.reserve(n);
       for (auto it = points.begin(); it != points.end(); ++it)
         constrained.push_back(get(cmap, *it) ? 1 : 0);
+    }
+    if constexpr (has_prior) {
+      const auto pmap = get_parameter(np, internal_np::orientation_prior_map);
+      prior.reserve(n);
+      std::size_t j = 0;
+      for (auto it = points.begin(); it != points.end(); ++it, ++j) {
+        const double a = double(get(pmap, *it));
+        if (!std::isfinite(a)) {
+          std::ostringstream msg;
+          msg << "orient_normals: point " << j << " has a non-finite orientation prior";
+          throw std::invalid_argument(msg.str());
+        }
+        prior.push_back(a);
+      }
     }
   }
   if (n == 0) {
@@ -310,6 +350,12 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
             sorted_constrained[q] = constrained[order[q]];
           constrained.swap(sorted_constrained);
         }
+        if (has_prior) {
+          std::vector<double> sorted_prior(n);
+          for (std::size_t q = 0; q < n; ++q)
+            sorted_prior[q] = prior[order[q]];
+          prior.swap(sorted_prior);
+        }
       }
       result.seconds.input = internal::seconds_since(t_start);
 
@@ -328,10 +374,43 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       const auto label_map = CGAL::make_property_map(labels);
       result.energy_before = energy(graph, weight, label_map);
 
-      // 3. Solve.
+      // 3. Solve, with unary terms when there are constraints or priors.
       auto t = std::chrono::steady_clock::now();
-      const Solver_report sr = solver.solve(graph, weight, label_map);
+      std::vector<char> has_unary; // per vertex, with unary terms only
+      Solver_report sr;
+      if constexpr (has_constraints || has_prior) {
+        typedef std::pair<double, double> Costs;
+        typedef decltype(boost::make_iterator_property_map(std::declval<std::vector<Costs>&>().begin(),
+                                                           get(boost::vertex_index, graph)))
+          Unary_map;
+        static_assert(internal::Accepts_unary<std::decay_t<decltype(solver)>, Neighbor_graph, std::decay_t<decltype(weight)>,
+                                              Unary_map, std::decay_t<decltype(label_map)>>::value,
+                      "orient_normals: point_is_constrained_map and orientation_prior_map need a solver with "
+                      "solve(graph, weight, unary, labels)");
+        // A constraint outweighs all the edges together.
+        double hard = 1.0;
+        typename boost::graph_traits<Neighbor_graph>::edge_iterator eit, eend;
+        for (boost::tie(eit, eend) = edges(graph); eit != eend; ++eit)
+          hard += std::abs(double(get(weight, *eit)));
+        std::vector<Costs> unary(n, Costs(0.0, 0.0));
+        has_unary.assign(n, 0);
+        for (std::size_t i = 0; i < n; ++i) {
+          double a = has_prior ? prior[i] : 0.0; // > 0: keep (label +1)
+          if (has_constraints && constrained[i])
+            a = hard;
+          if (a != 0.0 && nrm[i] != CGAL::NULL_VECTOR) {
+            unary[i] = a > 0.0 ? Costs(0.0, a) : Costs(-a, 0.0);
+            has_unary[i] = 1;
+            ++result.number_of_unary_terms;
+          }
+        }
+        sr = solver.solve(graph, weight, boost::make_iterator_property_map(unary.begin(), get(boost::vertex_index, graph)),
+                          label_map);
+      } else {
+        sr = solver.solve(graph, weight, label_map);
+      }
       result.frustrated_edges = sr.frustrated_edges;
+      result.number_of_segments = sr.segments;
       result.seconds.solve = internal::seconds_since(t);
       progress.report(0.9);
 
@@ -341,7 +420,11 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       result.number_of_components = connected_components(graph, weight, component);
       const Component_sign_input<Kernel> input{pts, nrm, labels, component, result.number_of_components,
                                                gr.radius, has_constraints ? &constrained : nullptr};
-      const std::vector<char> flip = sign_policy(input);
+      std::vector<char> flip = sign_policy(input);
+      // The solver gave the components with unary terms their sign.
+      for (std::size_t i = 0; i < has_unary.size(); ++i)
+        if (has_unary[i])
+          flip[component[i]] = 0;
       for (std::size_t i = 0; i < n; ++i)
         if (flip[component[i]])
           labels[i] = Label(-labels[i]);

@@ -34,7 +34,8 @@ namespace internal_np {
   X(flip_criterion_t, flip_criterion, flip_criterion) \
   X(solver_t, solver, solver) \
   X(component_sign_t, component_sign, component_sign) \
-  X(number_of_threads_t, number_of_threads, number_of_threads)
+  X(number_of_threads_t, number_of_threads, number_of_threads) \
+  X(orientation_prior_map_t, orientation_prior_map, orientation_prior_map)
 
 #define NORMAL_ORIENTATION_DECLARE_TAG(X, Y, Z) enum X { Y };
 NORMAL_ORIENTATION_NAMED_PARAMETERS(NORMAL_ORIENTATION_DECLARE_TAG)

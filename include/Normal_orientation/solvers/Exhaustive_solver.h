@@ -5,7 +5,7 @@
 
 /// \file Exhaustive_solver.h
 /// The exact solver by enumeration, for small problems: the oracle the
-/// other solvers are tested against.  Also the energy with unary terms.
+/// other solvers are tested against.
 
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/solvers/Solver_report.h>
@@ -25,29 +25,6 @@
 #include <vector>
 
 namespace Normal_orientation {
-
-/// \ingroup PkgNormalOrientationProblem
-/// Returns the energy of the labelling `labels` with unary terms:
-/// E(L) = sum over the edges e = (i, j) of `edge_energy(w_e, L_i, L_j)`
-/// (the energy of `energy(g, weight, labels)`) plus, for every vertex i,
-/// `get(unary, i).first` if L_i = +1 and `get(unary, i).second` if L_i = -1.
-/// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph`
-/// \tparam WeightMap a readable edge property map with a floating value
-/// \tparam UnaryMap a readable vertex property map whose value has members
-///         `first` (the cost of label +1) and `second` (the cost of label
-///         -1) convertible to `double`, such as `std::pair<double, double>`
-/// \tparam LabelMap a readable vertex property map with values +1/-1
-template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
-double energy(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels)
-{
-  double e = energy(g, weight, labels);
-  typename boost::graph_traits<Graph>::vertex_iterator it, end;
-  for (boost::tie(it, end) = vertices(g); it != end; ++it) {
-    const auto& costs = get(unary, *it);
-    e += int(get(labels, *it)) > 0 ? double(costs.first) : double(costs.second);
-  }
-  return e;
-}
 
 /// \ingroup PkgNormalOrientationSolvers
 /// The exact minimum of the orientation energy by enumeration of the
@@ -118,7 +95,7 @@ public:
   template <typename Graph, typename WeightMap, typename LabelMap>
   Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
   {
-    return solve_impl(g, weight, No_unary(), labels);
+    return solve_impl(g, weight, internal::No_unary(), labels);
   }
 
   /// Solves exactly the orientation problem with unary terms: minimises
@@ -144,10 +121,6 @@ public:
   }
 
 private:
-  /// the tag of the solve without unary terms
-  struct No_unary
-  {};
-
   /// the hard limit on the size of a component (states fit in 64 bits)
   static constexpr unsigned int hard_maximum_vertices = 62;
 
@@ -179,7 +152,7 @@ private:
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Solver_report solve_impl(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
   {
-    constexpr bool with_unary = !std::is_same<UnaryMap, No_unary>::value;
+    constexpr bool with_unary = !std::is_same<UnaryMap, internal::No_unary>::value;
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = num_vertices(g);
     auto index = get(boost::vertex_index, g);

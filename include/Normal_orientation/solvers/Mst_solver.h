@@ -21,6 +21,8 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace Normal_orientation {
@@ -52,8 +54,25 @@ namespace Normal_orientation {
 /// paper's Figure 2 example.  With `local_sweeps = 0` the solver is
 /// exactly the paper's Algorithm 1.
 ///
+/// <b>Unary terms.</b>  `solve()` also accepts unary terms (user
+/// constraints).  They are reduced exactly to edges to one extra "ground"
+/// vertex n whose label is +1: the costs (c+, c-) of vertex i are the
+/// constant min(c+, c-) plus `edge_energy(c- - c+, L_i, +1)`, an edge of
+/// signed weight c- - c+ between i and n (none when c+ = c-).  These edges
+/// are ranked with the others (after the edges of `g` of the same rank) and
+/// the same algorithm runs on the n + 1 vertices; then, if the ground came
+/// out -1, every vertex of its tree flips (which does not change the energy
+/// of the tree's edges), and the sweeps never move the ground but count its
+/// edges at every other vertex.  So a vertex whose unary cost difference
+/// exceeds the sum of the |w| of its edges ends with its cheaper label (up
+/// to the single-precision rounding of the ranks and sweeps);
+/// conflicting constraints are decided by the forest, strongest first.
+/// With zero unary terms the labels are those of the solve without them.
+///
 /// Cost: O(E) for the sort (radix), then O(E alpha(V)), then O(E) per sweep.
-/// Memory: about 24 bytes per edge and 7 bytes per vertex during the solve.
+/// Memory: about 24 bytes per edge and 7 bytes per vertex during the solve
+/// (with unary terms: plus about 40 bytes per vertex whose two costs
+/// differ, and 16 bytes per vertex while the costs are read).
 /// \cgalModels `OrientationSolver`
 class Mst_solver
 {
@@ -77,6 +96,58 @@ public:
   template <typename Graph, typename WeightMap, typename LabelMap>
   Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
   {
+    return solve_impl(g, weight, internal::No_unary(), labels);
+  }
+
+  /// Solves the orientation problem with unary terms: minimises (heuristically)
+  /// E(L) = sum over the edges of `edge_energy(w_e, L_i, L_j)` + sum over the
+  /// vertices of the unary cost of L_i (see the `energy()` overload with a
+  /// `unary` map), and writes +1/-1 to `labels` for every vertex.  Unary
+  /// costs may be negative; a vertex whose two costs are equal is
+  /// unconstrained.  `Solver_report::energy` includes the unary costs,
+  /// `Solver_report::iterations` counts the ground edges too (see the class
+  /// description), `Solver_report::tree_edges` and
+  /// `Solver_report::frustrated_edges` count the edges of `g` only.
+  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
+  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
+  /// \tparam WeightMap a readable edge property map with a floating value
+  /// \tparam UnaryMap a readable vertex property map whose value has members
+  ///         `first` (the cost of label +1) and `second` (the cost of label
+  ///         -1) convertible to `double`, such as `std::pair<double, double>`
+  /// \tparam LabelMap a writable vertex property map accepting `Label`
+  /// \throw std::invalid_argument if a unary cost is not finite
+  template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
+  Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
+  {
+    return solve_impl(g, weight, unary, labels);
+  }
+
+private:
+  /// the top bit of `Sorted_edge::head`: the weight is negative
+  static constexpr std::uint32_t negative_bit = 0x80000000u;
+
+  /// an informative edge: complement of the float bits of |w| (so that
+  /// larger |w| sorts first), ends, and the sign of w in the head's top bit
+  struct Sorted_edge
+  {
+    std::uint32_t key, tail, head;
+  };
+
+  /// the edge of signed weight `w` != 0 between `u` and `v`, with its key
+  static Sorted_edge make_sorted_edge(double w, std::uint32_t u, std::uint32_t v)
+  {
+    float a = float(std::abs(w));
+    std::uint32_t bits;
+    std::memcpy(&bits, &a, sizeof bits);
+    return {~bits, u, v | (w < 0.0 ? negative_bit : 0u)};
+  }
+
+  /// The solve, without unary terms when `UnaryMap` is `internal::No_unary`
+  /// (then vertex n, the ground, does not exist).
+  template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
+  Solver_report solve_impl(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
+  {
+    constexpr bool with_unary = !std::is_same<UnaryMap, internal::No_unary>::value;
     const auto start = std::chrono::steady_clock::now();
     typedef typename boost::graph_traits<Graph>::edge_iterator edge_iterator;
     const std::size_t n = num_vertices(g);
@@ -87,10 +158,11 @@ public:
     //    The sign of w is kept in the top bit of the head.  The ends travel
     //    with the key, so the Kruskal loop below reads the edges
     //    sequentially.
-    if (n >= std::size_t(negative_bit))
-      throw std::length_error("Mst_solver: more than 2^31 - 1 vertices");
+    if (n + (with_unary ? 1 : 0) >= std::size_t(negative_bit))
+      throw std::length_error(with_unary ? "Mst_solver: more than 2^31 - 2 vertices with unary terms"
+                                         : "Mst_solver: more than 2^31 - 1 vertices");
     std::vector<Sorted_edge> sorted;
-    sorted.reserve(std::size_t(num_edges(g)));
+    sorted.reserve(std::size_t(num_edges(g)) + (with_unary ? n : 0));
     edge_iterator it, end;
     for (boost::tie(it, end) = edges(g); it != end; ++it) {
       const double w = double(get(weight, *it));
@@ -100,11 +172,22 @@ public:
       const std::size_t v = std::size_t(get(index, target(*it, g)));
       if (u == v)
         continue;
-      float a = float(std::abs(w));
-      std::uint32_t bits;
-      std::memcpy(&bits, &a, sizeof bits);
-      sorted.push_back({~bits, std::uint32_t(u), std::uint32_t(v) | (w < 0.0 ? negative_bit : 0u)});
+      sorted.push_back(make_sorted_edge(w, std::uint32_t(u), std::uint32_t(v)));
     }
+    // With unary terms, the costs (c+, c-) of vertex i are the constant
+    // min(c+, c-) plus edge_energy(c- - c+, L_i, L_n) with the ground vertex
+    // n labelled +1: an edge of signed weight c- - c+ from i to n.
+    const std::uint32_t ground = std::uint32_t(n);
+    if constexpr (with_unary) {
+      const std::vector<std::pair<double, double>> costs = internal::unary_costs(g, unary, "Mst_solver");
+      for (std::size_t i = 0; i < n; ++i) {
+        const double w = costs[i].second - costs[i].first;
+        if (w != 0.0)
+          sorted.push_back(make_sorted_edge(w, std::uint32_t(i), ground));
+      }
+    } else
+      (void)unary;
+    const std::size_t vertex_count = n + (with_unary ? 1 : 0);
 
     // 2. Sort by decreasing |w|, ties in the order of edges(g): a stable
     //    least-significant-digit radix sort on the key, two 16-bit digits.
@@ -129,7 +212,7 @@ public:
     }
 
     // 3. Kruskal with orientation propagation on the signed union-find.
-    Signed_union_find uf(n);
+    Signed_union_find uf(vertex_count);
     Solver_report report;
     for (const Sorted_edge& e : sorted) {
       const std::uint32_t u = e.tail, v = e.head & ~negative_bit;
@@ -140,39 +223,49 @@ public:
       if ((su != sv) != ((e.head & negative_bit) != 0))
         uf.flip_root(rv);
       uf.unite_roots(ru, rv);
-      ++report.tree_edges;
+      if constexpr (with_unary)
+        report.tree_edges += (v != ground);
+      else
+        ++report.tree_edges;
     }
     report.iterations = sorted.size();
 
-    // 4. Labels, then energy and frustrated edges in one pass.
-    std::vector<Label> label(n);
-    for (std::size_t i = 0; i < n; ++i)
+    // 4. Labels, then energy and frustrated edges in one pass.  With unary
+    //    terms the ground must be +1: its tree is flipped if needed (the
+    //    energy of a tree does not change when all its labels flip).
+    std::vector<Label> label(vertex_count);
+    for (std::size_t i = 0; i < vertex_count; ++i)
       label[i] = Label(uf.sign(std::uint32_t(i)) ? -1 : 1);
+    if constexpr (with_unary) {
+      if (label[ground] < 0) {
+        const auto ground_root = uf.find(ground);
+        for (std::size_t i = 0; i < vertex_count; ++i)
+          if (uf.find(std::uint32_t(i)) == ground_root)
+            label[i] = Label(-label[i]);
+      }
+    }
+    // the sweeps never move the ground (vertex n), but see its edges
     if (local_sweeps > 0)
-      report.iterations += improve_vertices(n, sorted, label);
+      report.iterations += improve_vertices(vertex_count, n, sorted, label);
     typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
     for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit)
       put(labels, *vit, label[std::size_t(get(index, *vit))]);
     for (const Sorted_edge& e : sorted) {
       const bool negative = (e.head & negative_bit) != 0;
-      if ((label[e.tail] == label[e.head & ~negative_bit]) == negative)
+      const std::uint32_t v = e.head & ~negative_bit;
+      if constexpr (with_unary)
+        if (v == ground)
+          continue;
+      if ((label[e.tail] == label[v]) == negative)
         ++report.frustrated_edges;
     }
-    report.energy = energy(g, weight, labels);
+    if constexpr (with_unary)
+      report.energy = energy(g, weight, unary, labels);
+    else
+      report.energy = energy(g, weight, labels);
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;
   }
-
-private:
-  /// the top bit of `Sorted_edge::head`: the weight is negative
-  static constexpr std::uint32_t negative_bit = 0x80000000u;
-
-  /// an informative edge: complement of the float bits of |w| (so that
-  /// larger |w| sorts first), ends, and the sign of w in the head's top bit
-  struct Sorted_edge
-  {
-    std::uint32_t key, tail, head;
-  };
 
   /// the signed weight of `e`, as ranked (single precision)
   static float signed_weight(const Sorted_edge& e)
@@ -184,8 +277,10 @@ private:
   }
 
   /// Runs up to `local_sweeps` sweeps of single-vertex moves in vertex
-  /// order; returns the number of moves.
-  std::size_t improve_vertices(std::size_t n, const std::vector<Sorted_edge>& edges, std::vector<Label>& label) const
+  /// order on the `n` vertices of `edges`, of which only the first
+  /// `movable` may move; returns the number of moves.
+  std::size_t improve_vertices(std::size_t n, std::size_t movable, const std::vector<Sorted_edge>& edges,
+                               std::vector<Label>& label) const
   {
     // Incidence lists of the informative edges (both directions).
     std::vector<std::uint32_t> first(n + 1, 0);
@@ -209,7 +304,7 @@ private:
     std::size_t moves = 0;
     for (unsigned int sweep = 0; sweep < local_sweeps; ++sweep) {
       std::size_t moved = 0;
-      for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t i = 0; i < movable; ++i) {
         double support = 0.0;
         for (std::uint32_t t = first[i]; t < first[i + 1]; ++t)
           support += double(incident[t].second) * double(label[incident[t].first]);

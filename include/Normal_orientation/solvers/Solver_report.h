@@ -23,6 +23,9 @@ struct Solver_report
   std::size_t tree_edges = 0;
   /// edges whose wish the labelling does not meet
   std::size_t frustrated_edges = 0;
+  /// the number of vertices of the reduced (segment) graph the solver
+  /// worked on, 0 if it worked on the whole graph
+  std::size_t segments = 0;
   /// wall-clock seconds of the solve
   double seconds = 0.0;
 };
