@@ -4,8 +4,10 @@
 //
 // For each mesh and each noise level, generates a cloud in process (Mesh_sampler.h) and
 // orients copies of it with (a) Mst_solver(0), the paper's MST (Algorithm 1), (b) Mst_solver(),
-// our default (MST + 3 local sweeps), and (c) Qpbo_i_solver(orders, seed), MST + QPBO-I.
-// Every other parameter is at its default, so the three runs build the same graph.
+// MST + 3 local sweeps, (c) Qpbo_i_solver(orders, seed), MST + QPBO-I on the segment graph, and
+// (d) Lsa_tr_solver(), LSA-TR from the MST.  Every other parameter is at its default, so the
+// four runs build the same graph.  Subtotals per noise level and a check of the issue's quality
+// criteria follow the table.
 // Prints a Markdown table. See README.md.
 #include "Benchmark_options.h"
 #include "Mesh_sampler.h"
@@ -13,6 +15,7 @@
 #include <Normal_orientation/orient_normals.h>
 #include <Normal_orientation/parameters.h>
 #include <Normal_orientation/solvers/Mst_solver.h>
+#include <Normal_orientation/solvers/Lsa_tr_solver.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
 
 #include <CGAL/property_map.h>
@@ -40,10 +43,10 @@ namespace fs = std::filesystem;
 using namespace Normal_orientation::benchmark;
 
 /// Number of compared solvers.
-constexpr std::size_t number_of_solvers = 3;
+constexpr std::size_t number_of_solvers = 4;
 
 /// Column labels of the compared solvers, in table order.
-const std::array<const char*, number_of_solvers> solver_labels = {"MST", "MST+sweeps", "QPBO-I"};
+const std::array<const char*, number_of_solvers> solver_labels = {"MST", "MST+sweeps", "QPBO-I", "LSA-TR"};
 
 /// Command-line options of solver_quality (the seed also seeds the QPBO-I orders).
 struct Options : Cloud_options
@@ -64,6 +67,8 @@ struct Solver_row
   std::size_t wrong = 0;
   /// Seconds of the solver stage (Orientation_result::seconds.solve).
   double solve_seconds = 0.0;
+  /// Seconds of the neighbour graph (kd-tree, queries and weights).
+  double graph_seconds = 0.0;
 };
 
 /// One line of the table: a cloud and the result of each solver.
@@ -92,8 +97,9 @@ void print_usage(std::FILE* out)
     "  --seed S                  seed of the clouds and of QPBO-I (default 1)\n"
     "  --orders N                random orders of QPBO-I (default 3)\n"
     "  --threads T               maximum threads of orient_normals (default 0: all)\n"
-    "Orients copies of each cloud with Mst_solver(0) (paper MST), Mst_solver() (MST + 3 sweeps)\n"
-    "and Qpbo_i_solver(orders, seed) on the same graph and prints a Markdown table.\n"
+    "Orients copies of each cloud with Mst_solver(0) (paper MST), Mst_solver() (MST + 3 sweeps),\n"
+    "Qpbo_i_solver(orders, seed) and Lsa_tr_solver() on the same graph and prints a Markdown\n"
+    "table, subtotals per noise level and a check of the quality criteria of issue 3.\n"
     "Exit status: 0 on success, 1 on a runtime error, 2 on usage errors.\n");
 }
 
@@ -178,6 +184,7 @@ Solver_row run_solver(const Sampled_cloud& cloud, const Solver& solver, int thre
   Solver_row row;
   row.energy = result.energy_after;
   row.solve_seconds = result.seconds.solve;
+  row.graph_seconds = result.seconds.neighbors + result.seconds.graph;
   for(std::size_t i = 0; i < points.size(); ++i)
     if(!(points[i].second * cloud.true_normals[i] > 0.0))
       ++row.wrong;
@@ -197,13 +204,15 @@ void print_header()
   std::printf("| mesh | noise | points |");
   for(const char* label : solver_labels)
     std::printf(" E %s |", label);
-  std::printf(" red. %s | red. %s |", solver_labels[1], solver_labels[2]);
+  for(std::size_t s = 1; s < number_of_solvers; ++s)
+    std::printf(" red. %s |", solver_labels[s]);
   for(const char* label : solver_labels)
     std::printf(" wrong %s |", label);
+  std::printf(" graph s |");
   for(const char* label : solver_labels)
     std::printf(" solve s %s |", label);
   std::printf("\n|---|---:|---:|");
-  for(std::size_t c = 0; c < 2 * number_of_solvers + 2 + number_of_solvers; ++c)
+  for(std::size_t c = 0; c < 4 * number_of_solvers; ++c)
     std::printf("---:|");
   std::printf("\n");
 }
@@ -219,6 +228,7 @@ void print_line(const std::string& mesh, const std::string& noise, std::size_t p
     std::printf(" %.2f%% |", reduction_percent(solvers[0].energy, solvers[s].energy));
   for(const Solver_row& s : solvers)
     std::printf(" %zu (%.2f%%) |", s.wrong, points > 0 ? 100.0 * double(s.wrong) / double(points) : 0.0);
+  std::printf(" %.3f |", solvers[0].graph_seconds);
   for(const Solver_row& s : solvers)
     std::printf(" %.3f |", s.solve_seconds);
   std::printf("\n");
@@ -255,14 +265,27 @@ int main(int argc, char** argv)
     const Normal_orientation::Mst_solver paper_mst(0);
     const Normal_orientation::Mst_solver default_mst;
     const Normal_orientation::Qpbo_i_solver qpbo_i(options.orders, static_cast<unsigned long>(options.seed));
+    const Normal_orientation::Lsa_tr_solver lsa_tr;
 
     std::array<Solver_row, number_of_solvers> totals;
-    std::size_t total_points = 0;
+    std::vector<std::array<Solver_row, number_of_solvers>> noise_totals(options.noises.size());
+    std::vector<std::size_t> noise_points(options.noises.size(), 0);
+    std::size_t total_points = 0, clouds = 0, qpbo_above_mst = 0, lsa_above_mst = 0;
+    auto add = [](std::array<Solver_row, number_of_solvers>& sum, const std::array<Solver_row, number_of_solvers>& r) {
+      for(std::size_t s = 0; s < number_of_solvers; ++s)
+      {
+        sum[s].energy += r[s].energy;
+        sum[s].wrong += r[s].wrong;
+        sum[s].solve_seconds += r[s].solve_seconds;
+        sum[s].graph_seconds += r[s].graph_seconds;
+      }
+    };
     for(const std::string& mesh : meshes)
     {
       const Mesh_sampler sampler(mesh);
-      for(double noise : options.noises)
+      for(std::size_t level = 0; level < options.noises.size(); ++level)
       {
+        const double noise = options.noises[level];
         Sampling_options sampling;
         sampling.number_of_points = options.points;
         sampling.noise = noise;
@@ -277,22 +300,48 @@ int main(int argc, char** argv)
         row.solvers[0] = run_solver(cloud, paper_mst, options.threads, edges[0]);
         row.solvers[1] = run_solver(cloud, default_mst, options.threads, edges[1]);
         row.solvers[2] = run_solver(cloud, qpbo_i, options.threads, edges[2]);
-        if(edges[1] != edges[0] || edges[2] != edges[0])
-          throw std::runtime_error("the solvers did not see the same graph on '" + row.mesh + "'");
+        row.solvers[3] = run_solver(cloud, lsa_tr, options.threads, edges[3]);
+        for(std::size_t s = 1; s < number_of_solvers; ++s)
+          if(edges[s] != edges[0])
+            throw std::runtime_error("the solvers did not see the same graph on '" + row.mesh + "'");
 
         char noise_text[32];
         std::snprintf(noise_text, sizeof(noise_text), "%g", noise);
         print_line(row.mesh, noise_text, row.points, row.solvers);
-        for(std::size_t s = 0; s < number_of_solvers; ++s)
-        {
-          totals[s].energy += row.solvers[s].energy;
-          totals[s].wrong += row.solvers[s].wrong;
-          totals[s].solve_seconds += row.solvers[s].solve_seconds;
-        }
+        add(totals, row.solvers);
+        add(noise_totals[level], row.solvers);
+        noise_points[level] += row.points;
         total_points += row.points;
+        ++clouds;
+        // QPBO-I and LSA-TR start from the paper's MST labelling or better
+        const double slack = 1e-9 * (1.0 + row.solvers[0].energy);
+        qpbo_above_mst += row.solvers[2].energy > row.solvers[0].energy + slack;
+        lsa_above_mst += row.solvers[3].energy > row.solvers[0].energy + slack;
       }
     }
+    for(std::size_t level = 0; level < options.noises.size(); ++level)
+    {
+      char label[48];
+      std::snprintf(label, sizeof(label), "*noise %g*", options.noises[level]);
+      print_line(label, "", noise_points[level], noise_totals[level]);
+    }
     print_line("**total**", "", total_points, totals);
+
+    // The quality criteria of issue 3, on these clouds.
+    std::array<Solver_row, number_of_solvers> noisy;
+    for(std::size_t level = 0; level < options.noises.size(); ++level)
+      if(options.noises[level] > 0.0)
+        add(noisy, noise_totals[level]);
+    std::printf("\nclouds where the energy ends above the paper MST's: QPBO-I %zu of %zu, LSA-TR %zu of %zu\n",
+                qpbo_above_mst, clouds, lsa_above_mst, clouds);
+    std::printf("noisy clouds, total energy against the paper MST: QPBO-I %.1f%% lower, LSA-TR %.1f%% lower\n",
+                reduction_percent(noisy[0].energy, noisy[2].energy),
+                reduction_percent(noisy[0].energy, noisy[3].energy));
+    std::printf("noisy clouds, total energy against MST+sweeps: QPBO-I %.1f%% lower, LSA-TR %.1f%% lower\n",
+                reduction_percent(noisy[1].energy, noisy[2].energy),
+                reduction_percent(noisy[1].energy, noisy[3].energy));
+    std::printf("wrong normals over all clouds: MST %zu, MST+sweeps %zu, QPBO-I %zu, LSA-TR %zu\n",
+                totals[0].wrong, totals[1].wrong, totals[2].wrong, totals[3].wrong);
   }
   catch(const std::exception& e)
   {

@@ -84,7 +84,7 @@ struct Options
   unsigned int k = NO::default_number_of_neighbors;
   double radius = 0.0;
   std::string criterion = "hoppe";
-  std::string solver = "mst";
+  std::string solver = "qpbo-i";
   unsigned int orders = 3;
   std::string sign = "outward";
   bool has_viewpoint = false;
@@ -110,7 +110,8 @@ const char* usage_text =
   "  --k N                neighbours per point (default 12)\n"
   "  --radius R           neighbour radius (default: estimated from the data)\n"
   "  --criterion NAME     flip criterion: hoppe (default), xie, konig\n"
-  "  --solver NAME        solver: mst (default), qpbo-i, lsa-tr (lower energy, slower)\n"
+  "  --solver NAME        solver: qpbo-i (default: MST, then QPBO-I on the segment graph),\n"
+  "                       mst (fastest), lsa-tr\n"
   "  --orders N           qpbo-i: random orders tried, the best is kept (default 3)\n"
   "  --sign NAME          component sign: outward (default), keep\n"
   "  --viewpoint X,Y,Z    make every component face this point instead\n"
@@ -303,7 +304,7 @@ NO::Orientation_result run(Range& range, const Np& np, const Criterion& criterio
       range, np.flip_criterion(criterion).component_sign(sign).solver(NO::Qpbo_i_solver(o.orders, o.seed)));
   if (o.solver == "lsa-tr")
     return NO::orient_normals(range, np.flip_criterion(criterion).component_sign(sign).solver(NO::Lsa_tr_solver()));
-  return NO::orient_normals(range, np.flip_criterion(criterion).component_sign(sign));
+  return NO::orient_normals(range, np.flip_criterion(criterion).component_sign(sign).solver(NO::Mst_solver()));
 }
 
 template <typename Range, typename Np>
