@@ -44,11 +44,30 @@ namespace Normal_orientation {
 /// was reached by 1 order on 206, 3 orders on 232, 8 orders on 257 and 16
 /// orders on 266 of them; the MST alone on 93.
 ///
+/// <b>Large graphs</b> (more than `reduction_threshold` vertices) are first
+/// reduced to a segment graph (`reduce`): the paper's segmentation (sec.
+/// 5.1, supplement sec. 3) run in core, in vertex order, in the frame of the
+/// MST labelling y, so that a segment is a patch where y is consistent by
+/// the paper's intra- and inter-segment criteria.  QPBO-I then solves the
+/// segment graph (about 1-10% of the vertices on the benchmark clouds),
+/// whose labelling all +1 is y, and single-vertex sweeps refine the
+/// expanded labelling on the whole graph.  Whole patches still move, which
+/// is what the MST cannot do; what is lost are moves that split a patch.
+/// On the 24 benchmark clouds of 30k points the reduced solve reaches a
+/// lower energy than the unreduced batched one on most clouds (its fixes
+/// are not batched), leaves fewer wrong normals, and is 10-20 times faster;
+/// at 1M points it adds 0.5-1 s to the MST's solve.
+///
 /// Cost: each re-solve updates the max-flow incrementally, then recomputes
 /// the persistent labels in O(V + E); with `maximum_solves` re-solves per
 /// order, an order costs O(maximum_solves * (V + E)) plus the flow
-/// augmentations.  Solving only the frustrated regions of large clouds is
-/// work in progress.
+/// augmentations, on the segment graph for large graphs.  The reduction
+/// itself is O(V + E) and needs about 8 bytes per edge end.
+///
+/// <b>Unary terms</b> (`solve(g, weight, unary, labels)`) enter the MST as
+/// edges to a ground vertex, QPBO as unary terms, and the segment graph as
+/// sums over the segments; constraints stronger than all the edges together
+/// are always met.
 /// \cgalModels `OrientationSolver`
 class Qpbo_i_solver
 {
