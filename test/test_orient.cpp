@@ -58,17 +58,21 @@ struct My_normal_map
   friend void put(const My_normal_map&, My_point& x, const Vector& v) { x.normal = v; }
 };
 
-/// marks the points of a vector as constrained, by address
-struct Is_fixed
+/// a value per point of a vector, found by the point's address (the
+/// constrained flags, the priors)
+template <typename T>
+struct By_address_map
 {
   typedef PN key_type;
-  typedef bool value_type;
-  typedef bool reference;
+  typedef T value_type;
+  typedef T reference;
   typedef boost::readable_property_map_tag category;
   const PN* base;
-  const std::vector<bool>* fixed;
-  friend bool get(const Is_fixed& m, const PN& x) { return (*m.fixed)[std::size_t(&x - m.base)]; }
+  const std::vector<T>* values;
+  friend T get(const By_address_map& m, const PN& x) { return (*m.values)[std::size_t(&x - m.base)]; }
 };
+typedef By_address_map<bool> Is_fixed;
+typedef By_address_map<double> Prior_map;
 
 template <typename Params>
 std::size_t orient_and_count(const std::vector<Sample>& truth, std::vector<PN>& cloud, const Params& np)
@@ -325,18 +329,6 @@ TEST(Orient_normals, ConstraintsAndViewpointDecideTheSign)
 }
 
 namespace {
-
-/// a soft prior per point, by address
-struct Prior_map
-{
-  typedef PN key_type;
-  typedef double value_type;
-  typedef double reference;
-  typedef boost::readable_property_map_tag category;
-  const PN* base;
-  const std::vector<double>* prior;
-  friend double get(const Prior_map& m, const PN& x) { return (*m.prior)[std::size_t(&x - m.base)]; }
-};
 
 template <typename Solver>
 void check_constraints_and_priors(const Solver& solver, const char* name)

@@ -132,13 +132,11 @@ public:
     return solve_impl(g, weight, internal::No_unary(), labels);
   }
 
-  /// Solves the orientation problem with unary terms: minimises the
-  /// energy of `energy(g, weight, unary, labels)` and writes +1/-1 to
-  /// `labels` for every vertex.  A unary cost larger than the sum of the
-  /// |weights| at a vertex makes its label a hard constraint.
-  /// \tparam UnaryMap a readable vertex property map whose value has members
-  ///         `first` (the cost of label +1) and `second` (the cost of label
-  ///         -1) convertible to `double`, such as `std::pair<double, double>`
+  /// The same with unary terms (see the `OrientationSolver` concept and
+  /// the `energy()` overload with a `unary` map, whose energy the report
+  /// gives): the unary map's values have members `first` and `second`, the
+  /// costs of the labels +1 and -1.  A cost larger than the sum of all the
+  /// |weights| makes the label of its vertex a hard constraint.
   /// \throw std::invalid_argument if a weight or a unary cost is not finite
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
