@@ -668,3 +668,113 @@ TEST(Segment_reduction, ReducedQpboINeverAboveMstAndHonoursConstraints)
   std::cout << "[ info ] noisy strips: MST " << mst_total << ", reduced QPBO-I " << reduced_total << "\n";
   EXPECT_LT(reduced_total, 0.95 * mst_total);
 }
+
+// ---------------------------------------------------------------------------
+// The streaming segmenter with preliminary flips (streaming::Segmenter).
+
+namespace {
+
+struct Streamed_segmentation
+{
+  std::vector<std::uint32_t> segment;
+  std::vector<NO::Label> flip;
+  NO::internal::Array_problem reduced;
+};
+
+// feeds the vertices of g in index order, each with its earlier neighbours'
+// votes in their flipped frames, as the sweep will
+Streamed_segmentation stream_segments(const Ugraph& g, const NO::streaming::Segmentation_thresholds& theta)
+{
+  const std::size_t n = boost::num_vertices(g);
+  Streamed_segmentation s;
+  s.segment.assign(n, 0);
+  s.flip.assign(n, 1);
+  NO::streaming::Segmenter segmenter(theta);
+  std::vector<NO::streaming::Neighbor_vote> votes;
+  for (std::size_t i = 0; i < n; ++i) {
+    votes.clear();
+    for (auto e : boost::make_iterator_range(boost::out_edges(i, g))) {
+      const std::size_t j = boost::target(e, g);
+      if (j < i)
+        votes.push_back({s.segment[j], get(boost::edge_weight, g, e) * s.flip[j]});
+    }
+    const std::size_t before = segmenter.number_of_segments();
+    const NO::streaming::Segment_assignment a = segmenter.add_point(votes);
+    EXPECT_EQ(a.opened, segmenter.number_of_segments() == before + 1);
+    EXPECT_LT(a.segment, segmenter.number_of_segments());
+    s.segment[i] = a.segment;
+    s.flip[i] = a.flip;
+  }
+  EXPECT_EQ(segmenter.number_of_points(), n);
+  const auto& pairs = segmenter.segment_pairs();
+  s.reduced.number_of_vertices = segmenter.number_of_segments();
+  for (std::size_t p = 0; p < pairs.size(); ++p) {
+    s.reduced.tail.push_back(pairs.first(p));
+    s.reduced.head.push_back(pairs.second(p));
+    s.reduced.weight.push_back(pairs.weight(p));
+  }
+  return s;
+}
+
+} // namespace
+
+TEST(Streaming_segmenter, BalancedGraphsGiveConsistentSegmentsAndAnExactSegmentGraph)
+{
+  std::mt19937_64 rng(17);
+  for (int t = 0; t < 20; ++t) {
+    const Ugraph g = balanced_graph(rng, 400, 1600);
+    const Streamed_segmentation s = stream_segments(g, NO::streaming::Segmentation_thresholds());
+    ASSERT_LT(s.reduced.number_of_vertices, 400u);
+    // inside a segment every edge agrees with the preliminary flips
+    for (auto e : boost::make_iterator_range(boost::edges(g))) {
+      const std::size_t i = boost::source(e, g), j = boost::target(e, g);
+      if (s.segment[i] == s.segment[j]) {
+        ASSERT_GT(get(boost::edge_weight, g, e) * s.flip[i] * s.flip[j], 0.0) << "trial " << t;
+      }
+    }
+    // the segment graph has an exact solution of energy 0, which expands to
+    // a labelling of energy 0 of the whole graph
+    const NO::internal::Array_problem& q = s.reduced;
+    Ugraph sg(q.number_of_vertices);
+    for (std::size_t e = 0; e < q.weight.size(); ++e)
+      if (q.weight[e] != 0.0)
+        boost::add_edge(q.tail[e], q.head[e], q.weight[e], sg);
+    std::vector<NO::Label> x, full(400);
+    solve(NO::Mst_solver(), sg, x);
+    for (std::size_t i = 0; i < 400; ++i)
+      full[i] = NO::Label(s.flip[i] * x[s.segment[i]]);
+    ASSERT_NEAR(NO::energy(g, get(boost::edge_weight, g), CGAL::make_property_map(full)), 0.0, 1e-9) << "trial " << t;
+  }
+}
+
+TEST(Streaming_segmenter, SegmentGraphEnergyIsExactUpToAConstantWithFlips)
+{
+  std::mt19937_64 rng(23);
+  for (int t = 0; t < 10; ++t) {
+    const Ugraph g = random_graph(rng, 300, 1500, 0.2);
+    NO::streaming::Segmentation_thresholds theta;
+    theta.contradiction = 0.25 * (t % 3);
+    theta.acceptance = 0.3;
+    const Streamed_segmentation s = stream_segments(g, theta);
+    const std::size_t m = s.reduced.number_of_vertices;
+    ASSERT_GT(m, 1u);
+    ASSERT_LT(m, 300u);
+    // determinism
+    const Streamed_segmentation again = stream_segments(g, theta);
+    ASSERT_EQ(again.segment, s.segment);
+    ASSERT_EQ(again.flip, s.flip);
+    double offset = 0.0;
+    for (int k = 0; k < 20; ++k) {
+      std::vector<NO::Label> x(m, NO::Label(1)), full(300);
+      if (k > 0)
+        for (NO::Label& l : x)
+          l = (rng() & 1) ? 1 : -1;
+      for (std::size_t i = 0; i < 300; ++i)
+        full[i] = NO::Label(s.flip[i] * x[s.segment[i]]);
+      const double d = NO::energy(g, get(boost::edge_weight, g), CGAL::make_property_map(full)) - s.reduced.energy(x);
+      if (k == 0)
+        offset = d;
+      ASSERT_NEAR(d, offset, 1e-9) << "trial " << t << ", labelling " << k;
+    }
+  }
+}

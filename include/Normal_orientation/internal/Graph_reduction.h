@@ -11,6 +11,7 @@
 /// full problem that keep every segment rigid.
 
 #include <Normal_orientation/Orientation_problem.h>
+#include <Normal_orientation/streaming/Segmenter.h>
 
 #include <boost/graph/graph_traits.hpp>
 #include <boost/graph/properties.hpp>
@@ -212,96 +213,8 @@ inline std::size_t improve_by_sweeps(const Incidence& inc, const std::vector<dou
   return moves;
 }
 
-/// An open-addressing hash map from a pair of segment numbers (a < b) to
-/// the sum of the weights between them, in insertion order.
-class Segment_pair_weights
-{
-public:
-  Segment_pair_weights() : m_slot(1024, empty) {}
-
-  /// the accumulated weight between `a` and `b` (0 when none)
-  double get(std::uint32_t a, std::uint32_t b) const
-  {
-    const std::uint64_t key = make_key(a, b);
-    for (std::size_t h = hash(key) & (m_slot.size() - 1);; h = (h + 1) & (m_slot.size() - 1)) {
-      const std::uint32_t s = m_slot[h];
-      if (s == empty)
-        return 0.0;
-      if (m_key[s] == key)
-        return m_weight[s];
-    }
-  }
-
-  /// adds `w` to the weight between `a` and `b`
-  void add(std::uint32_t a, std::uint32_t b, double w)
-  {
-    const std::uint64_t key = make_key(a, b);
-    for (std::size_t h = hash(key) & (m_slot.size() - 1);; h = (h + 1) & (m_slot.size() - 1)) {
-      const std::uint32_t s = m_slot[h];
-      if (s == empty) {
-        m_slot[h] = std::uint32_t(m_key.size());
-        m_key.push_back(key);
-        m_weight.push_back(w);
-        if (2 * m_key.size() > m_slot.size())
-          grow();
-        return;
-      }
-      if (m_key[s] == key) {
-        m_weight[s] += w;
-        return;
-      }
-    }
-  }
-
-  /// the number of pairs
-  std::size_t size() const { return m_key.size(); }
-  /// the smaller segment of the `i`-th pair inserted
-  std::uint32_t first(std::size_t i) const { return std::uint32_t(m_key[i] >> 32); }
-  /// the larger segment of the `i`-th pair inserted
-  std::uint32_t second(std::size_t i) const { return std::uint32_t(m_key[i]); }
-  /// the weight of the `i`-th pair inserted
-  double weight(std::size_t i) const { return m_weight[i]; }
-
-private:
-  static constexpr std::uint32_t empty = ~std::uint32_t(0);
-
-  static std::uint64_t make_key(std::uint32_t a, std::uint32_t b)
-  {
-    return a < b ? (std::uint64_t(a) << 32) | b : (std::uint64_t(b) << 32) | a;
-  }
-  static std::size_t hash(std::uint64_t key)
-  {
-    key ^= key >> 33;
-    key *= 0xff51afd7ed558ccdULL;
-    key ^= key >> 33;
-    return std::size_t(key);
-  }
-  void grow()
-  {
-    std::vector<std::uint32_t> slot(2 * m_slot.size(), empty);
-    for (std::size_t s = 0; s < m_key.size(); ++s) {
-      std::size_t h = hash(m_key[s]) & (slot.size() - 1);
-      while (slot[h] != empty)
-        h = (h + 1) & (slot.size() - 1);
-      slot[h] = std::uint32_t(s);
-    }
-    m_slot.swap(slot);
-  }
-
-  std::vector<std::uint32_t> m_slot;
-  std::vector<std::uint64_t> m_key;
-  std::vector<double> m_weight;
-};
-
-/// The thresholds of the segmentation (paper sec. 5.1, supplement eq. 5-7).
-struct Segmentation_thresholds
-{
-  /// theta_S: the tolerated sum of contradicting votes, inside a segment
-  /// and across segment borders
-  double contradiction = 0.0;
-  /// theta_acc: the smallest vote of a segment that a vertex may join
-  double acceptance = 0.5;
-};
+/// the thresholds of the segmentation
+typedef streaming::Segmentation_thresholds Segmentation_thresholds;
 
 /// A segmentation of a problem and the problem it reduces to.
 struct Segment_reduction
@@ -314,82 +227,39 @@ struct Segment_reduction
   Array_problem reduced;
 };
 
-/// Segments `p` around the labelling `start` in vertex order, as the
-/// paper's segmentation (sec. 5.1) with the preliminary orientation given by
-/// `start`: in the frame where `start` is all +1 (vote(i, j) = w_ij * L_i *
-/// L_j), vertex i joins the segment of its earlier neighbours whose vote is
-/// largest among those that (intra-segment criterion) vote at least
-/// theta_acc, with contradicting votes summing to at most theta_S, and
-/// (inter-segment criterion) whose accumulated weight to every other
-/// neighbouring segment t does not contradict i's vote for t by more than
-/// theta_S; otherwise it opens a new segment.  Vertex i may not flip against
-/// `start`, so `start` is a labelling of the reduced problem (all +1) and a
-/// solver started there never ends above it.  A reduced labelling X maps
-/// back to L_i = start_i * X_segment(i), with the same energy up to the
-/// constant of the edges inside the segments.  Cost: O(V + E) expected.
+/// Segments the problem of `inc` around the labelling `start` in vertex
+/// order, with the paper's segmentation (`streaming::Segmenter`) in the
+/// frame where `start` is all +1 (vote(i, j) = w_ij * L_i * L_j), and
+/// without flips (`may_flip = false`): vertex i joins the segment of its
+/// earlier neighbours whose vote is largest among the valid ones, or opens
+/// a new segment.  So `start` is a labelling of the reduced problem (all
+/// +1) and a solver started there never ends above it.  A reduced
+/// labelling X maps back to L_i = start_i * X_segment(i), with the same
+/// energy up to the constant of the edges inside the segments.
 /// `preference` is empty or holds the unary preference of every vertex (see
-/// `Array_problem`).
+/// `Array_problem`).  Cost: O(V + E) expected.
 inline Segment_reduction reduce_to_segments(const Incidence& inc, const std::vector<double>& preference,
                                             const std::vector<Label>& start,
                                             const Segmentation_thresholds& theta = Segmentation_thresholds())
 {
   const std::size_t n = inc.number_of_vertices();
-  const std::uint32_t unset = ~std::uint32_t(0);
   Segment_reduction r;
-  r.segment.assign(n, unset);
-  Segment_pair_weights between;
-  struct Vote
-  {
-    std::uint32_t segment;
-    double positive, negative;
-  };
-  std::vector<Vote> votes;
-  std::uint32_t count = 0;
+  r.segment.assign(n, 0);
+  streaming::Segmenter segmenter(theta, false);
+  std::vector<streaming::Neighbor_vote> votes;
   for (std::size_t i = 0; i < n; ++i) {
     votes.clear();
     for (std::uint32_t t = inc.first[i]; t < inc.first[i + 1]; ++t) {
       const std::uint32_t j = inc.other[t];
-      if (r.segment[j] == unset)
-        continue;
-      const double v = double(inc.weight[t]) * double(start[i]) * double(start[j]);
-      auto it = std::find_if(votes.begin(), votes.end(),
-                             [&](const Vote& x) { return x.segment == r.segment[j]; });
-      if (it == votes.end())
-        it = votes.insert(votes.end(), Vote{r.segment[j], 0.0, 0.0});
-      (v > 0.0 ? it->positive : it->negative) += v;
+      if (j < i)
+        votes.push_back({r.segment[j], double(inc.weight[t]) * double(start[i]) * double(start[j])});
     }
-    std::uint32_t best = unset;
-    double best_vote = theta.acceptance;
-    for (const Vote& s : votes) {
-      const double vote = s.positive + s.negative;
-      if (vote < best_vote || -s.negative > theta.contradiction || (best != unset && vote == best_vote))
-        continue;
-      bool valid = true;
-      for (const Vote& t : votes) {
-        if (t.segment == s.segment)
-          continue;
-        const double a = t.positive + t.negative;
-        const double w = between.get(s.segment, t.segment);
-        if (w != 0.0 && a != 0.0 && ((w > 0.0) != (a > 0.0)) && std::abs(a) > theta.contradiction) {
-          valid = false;
-          break;
-        }
-      }
-      if (valid) {
-        best = s.segment;
-        best_vote = vote;
-      }
-    }
-    if (best == unset)
-      best = count++;
-    r.segment[i] = best;
-    for (const Vote& t : votes)
-      if (t.segment != best)
-        between.add(best, t.segment, t.positive + t.negative);
+    r.segment[i] = segmenter.add_point(votes, preference.empty() ? 0.0 : preference[i] * double(start[i])).segment;
   }
 
+  const streaming::internal::Segment_pair_weights& between = segmenter.segment_pairs();
   Array_problem& q = r.reduced;
-  q.number_of_vertices = count;
+  q.number_of_vertices = segmenter.number_of_segments();
   q.tail.reserve(between.size());
   q.head.reserve(between.size());
   q.weight.reserve(between.size());
@@ -399,11 +269,8 @@ inline Segment_reduction reduce_to_segments(const Incidence& inc, const std::vec
       q.head.push_back(between.second(s));
       q.weight.push_back(between.weight(s));
     }
-  if (!preference.empty()) {
-    q.preference.assign(count, 0.0);
-    for (std::size_t i = 0; i < n; ++i)
-      q.preference[r.segment[i]] += preference[i] * double(start[i]);
-  }
+  if (!preference.empty())
+    q.preference = segmenter.segment_preferences();
   return r;
 }
 
