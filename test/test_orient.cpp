@@ -450,3 +450,145 @@ TEST(Orient_normals, SharedMeshesWhenPresent)
   const std::size_t wrong = orient_and_count(truth, cloud, pn_params());
   EXPECT_LT(wrong, truth.size() / 100) << wrong << " wrong normals of " << truth.size();
 }
+
+// ---------------------------------------------------------------------------
+// The streaming sweep hands over exactly the in-core neighbour graph.
+
+#include <Normal_orientation/streaming/Sweep.h>
+
+namespace {
+
+struct Vector_source
+{
+  const std::vector<NO::streaming::Point_record>* records;
+  std::size_t next = 0;
+  std::size_t read(std::vector<NO::streaming::Point_record>& chunk, std::size_t maximum)
+  {
+    const std::size_t m = std::min(maximum, records->size() - next);
+    chunk.insert(chunk.end(), records->begin() + std::ptrdiff_t(next), records->begin() + std::ptrdiff_t(next + m));
+    next += m;
+    return m;
+  }
+};
+
+struct Edge_collector
+{
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> edges;
+  std::vector<float> squared_distances;
+  std::uint64_t next_final = 0, next_release = 0;
+  bool in_order = true;
+  template <typename Window>
+  void finalize(Window& w, std::uint64_t s, const std::vector<NO::streaming::Sweep_neighbor>& earlier)
+  {
+    in_order = in_order && s == next_final++;
+    w.payload(s) = int(s);
+    for (const auto& n : earlier) {
+      in_order = in_order && n.sequence < s && n.sequence >= w.first() && w.payload(n.sequence) == int(n.sequence);
+      edges.push_back({n.sequence, s});
+      squared_distances.push_back(n.squared_distance);
+    }
+  }
+  template <typename Window>
+  void release(Window&, std::uint64_t s)
+  {
+    in_order = in_order && s == next_release++;
+  }
+};
+
+std::vector<NO::streaming::Point_record> sorted_records(const std::vector<Sample>& s)
+{
+  std::vector<NO::streaming::Point_record> r(s.size());
+  for (std::size_t i = 0; i < s.size(); ++i)
+    r[i] = NO::streaming::Point_record{{s[i].p.x(), s[i].p.y(), s[i].p.z()}, {s[i].n.x(), s[i].n.y(), s[i].n.z()}, i};
+  std::sort(r.begin(), r.end(), [](const auto& a, const auto& b) {
+    return a.position[0] != b.position[0] ? a.position[0] < b.position[0] : a.index < b.index;
+  });
+  return r;
+}
+
+} // namespace
+
+TEST(Streaming_sweep, GivesExactlyTheInCoreGraphWithBoundedWindow)
+{
+  std::mt19937_64 rng(8);
+  for (const std::size_t batch : {std::size_t(7), std::size_t(500), std::size_t(1) << 20}) {
+    const auto shape = torus(batch == 7 ? 3000 : 20000, rng);
+    const auto records = sorted_records(shape);
+    const std::size_t n = records.size();
+    std::vector<Point> pts;
+    std::vector<Vector> nrm;
+    for (const auto& r : records) {
+      pts.emplace_back(r.position[0], r.position[1], r.position[2]);
+      nrm.emplace_back(r.normal[0], r.normal[1], r.normal[2]);
+    }
+    NO::Neighbor_graph g;
+    const NO::Neighbor_graph_report gr = NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(
+      pts, nrm, 12, 0.0, NO::Hoppe_criterion(), g, NO::internal::Progress(std::function<bool(double)>()));
+    std::vector<std::pair<std::uint64_t, std::uint64_t>> expected;
+    for (auto e : boost::make_iterator_range(edges(g))) {
+      const std::uint64_t a = source(e, g), b = target(e, g);
+      expected.push_back({std::min(a, b), std::max(a, b)});
+    }
+    std::sort(expected.begin(), expected.end());
+
+    Vector_source src{&records};
+    Edge_collector visitor;
+    NO::streaming::Sweep_window<int> window;
+    NO::streaming::Sweep_options options;
+    options.radius = gr.radius;
+    options.batch_size = batch;
+    const NO::streaming::Sweep_report report = NO::streaming::sweep<CGAL::Parallel_tag, Kernel>(
+      src, [](const NO::streaming::Point_record& r) { return r.position[0]; }, options, visitor, window);
+    auto got = visitor.edges;
+    std::sort(got.begin(), got.end());
+    EXPECT_TRUE(visitor.in_order) << "batch " << batch;
+    EXPECT_EQ(visitor.next_final, n);
+    EXPECT_EQ(visitor.next_release, n);
+    EXPECT_EQ(report.number_of_points, n);
+    EXPECT_EQ(report.number_of_edges, expected.size());
+    EXPECT_EQ(got, expected) << "batch " << batch;
+    // the window never holds more than a slab of thickness 3r, a batch and a read
+    std::size_t slab = 0;
+    for (std::size_t i = 0, j = 0; i < n; ++i) {
+      while (records[j].position[0] <= records[i].position[0] - 2.0 * gr.radius)
+        ++j;
+      std::size_t e = i;
+      while (e < n && records[e].position[0] <= records[i].position[0] + gr.radius)
+        ++e;
+      slab = std::max(slab, e - j);
+    }
+    EXPECT_LE(report.peak_window, slab + batch + std::max<std::size_t>(64, std::min<std::size_t>(batch, 65536)) + 1)
+      << "batch " << batch;
+    if (batch <= 500) {
+      EXPECT_LT(report.peak_window, n) << "batch " << batch;
+      EXPECT_GT(report.number_of_batches, 10u);
+    }
+    std::cout << "[ info ] sweep, batch " << batch << ": " << n << " points, peak window " << report.peak_window
+              << ", slab of 3r " << slab << ", " << report.number_of_batches << " batches\n";
+  }
+}
+
+TEST(Streaming_sweep, RefusesUnsortedInput)
+{
+  std::mt19937_64 rng(9);
+  auto records = sorted_records(sphere(2000, rng));
+  std::swap(records[1500], records[1700]);
+  Vector_source src{&records};
+  Edge_collector visitor;
+  NO::streaming::Sweep_window<int> window;
+  NO::streaming::Sweep_options options;
+  options.radius = 0.2;
+  options.batch_size = 100;
+  try {
+    NO::streaming::sweep<CGAL::Sequential_tag, Kernel>(
+      src, [](const NO::streaming::Point_record& r) { return r.position[0]; }, options, visitor, window);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not sorted"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("point 1501"), std::string::npos) << e.what();
+  }
+  options.radius = -1.0;
+  EXPECT_THROW((NO::streaming::sweep<CGAL::Sequential_tag, Kernel>(
+                 src, [](const NO::streaming::Point_record& r) { return r.position[0]; }, options, visitor, window)),
+               std::invalid_argument);
+}

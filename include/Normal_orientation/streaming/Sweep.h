@@ -1,0 +1,334 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_STREAMING_SWEEP_H
+#define NORMAL_ORIENTATION_STREAMING_SWEEP_H
+
+/// \file Sweep.h
+/// The sweep of the streaming pipeline (paper sec. 5; Pajarola 2005): points
+/// sorted along a sweep axis pass through a window of bounded size; each
+/// point is handed over, in the sweep order, with its earlier neighbours in
+/// the symmetric, radius-truncated k-nearest-neighbour graph, exactly the
+/// edges `build_neighbor_graph()` would give in core.
+
+#include <Normal_orientation/Neighbor_graph.h>
+#include <Normal_orientation/streaming/Point_record.h>
+
+#include <CGAL/Kd_tree.h>
+#include <CGAL/Orthogonal_k_neighbor_search.h>
+#include <CGAL/Search_traits_3.h>
+#include <CGAL/Search_traits_adapter.h>
+#include <CGAL/property_map.h>
+
+#include <boost/iterator/counting_iterator.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <utility>
+#include <vector>
+
+namespace Normal_orientation {
+namespace streaming {
+
+/// \ingroup PkgNormalOrientationStreaming
+/// The parameters of `sweep()`.
+struct Sweep_options
+{
+  /// k of the k-nearest-neighbour graph
+  unsigned int number_of_neighbors = 12;
+  /// r: no edge is as long as r; must be > 0 and finite
+  double radius = 0.0;
+  /// points finalised per batch (one kd-tree over the window per batch)
+  std::size_t batch_size = std::size_t(1) << 18;
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// An earlier neighbour of the point being finalised: its sequence number
+/// (position in the sweep order) and the squared distance, in single
+/// precision as in `build_neighbor_graph()`.
+struct Sweep_neighbor
+{
+  /// the sequence number of the neighbour
+  std::uint64_t sequence;
+  /// the squared distance to it
+  float squared_distance;
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// What `sweep()` measured.
+struct Sweep_report
+{
+  /// points swept
+  std::uint64_t number_of_points = 0;
+  /// edges handed over (each undirected edge once, to its later end)
+  std::uint64_t number_of_edges = 0;
+  /// batches, hence kd-trees built
+  std::size_t number_of_batches = 0;
+  /// the largest number of points held in the window at once
+  std::size_t peak_window = 0;
+  /// seconds spent in the kd-trees and queries
+  double seconds_neighbors = 0.0;
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// The window of a sweep, as the visitor sees it: the points between the
+/// oldest one not yet released and the front, by sequence number, with one
+/// `Payload` per point for the visitor's own state (a segment, a flip...).
+template <typename Payload>
+class Sweep_window
+{
+public:
+  /// the record of point `sequence` (it must be in the window)
+  const Point_record& record(std::uint64_t sequence) const { return slot(sequence).record; }
+  /// the payload of point `sequence` (it must be in the window)
+  Payload& payload(std::uint64_t sequence) { return m_slots[std::size_t(sequence - m_base)].payload; }
+  /// the payload of point `sequence` (it must be in the window)
+  const Payload& payload(std::uint64_t sequence) const { return slot(sequence).payload; }
+  /// the sequence number of the oldest point in the window
+  std::uint64_t first() const { return m_base; }
+  /// one past the sequence number of the newest point in the window
+  std::uint64_t end() const { return m_base + m_slots.size(); }
+  /// the number of points held
+  std::size_t size() const { return m_slots.size(); }
+
+private:
+  template <typename C, typename K, typename S, typename F, typename V, typename P>
+  friend Sweep_report sweep(S&, F, const Sweep_options&, V&, Sweep_window<P>&);
+
+  struct Slot
+  {
+    Point_record record;
+    double key;
+    Payload payload;
+  };
+  const Slot& slot(std::uint64_t sequence) const { return m_slots[std::size_t(sequence - m_base)]; }
+
+  std::deque<Slot> m_slots;
+  std::uint64_t m_base = 0;
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Sweeps the points of `source` (a model of the streaming source concept:
+/// `std::size_t read(std::vector<Point_record>& chunk, std::size_t maximum)`
+/// appends up to `maximum` records and returns how many, 0 at the end),
+/// which must be sorted by `key(record)` (non-decreasing; checked as they
+/// are read).
+///
+/// Every point p is finalised once all the points with a key below
+/// key(p) + r have been read, in the sweep order: `visitor.finalize(window,
+/// sequence, earlier)` is called with its neighbours of smaller sequence
+/// number in the graph of `build_neighbor_graph()` (j is a neighbour of p
+/// iff one is among the other's k nearest and |p - j| < r; `earlier` is
+/// sorted by sequence number), all of them still in `window`.  A point is
+/// released (`visitor.release(window, sequence)`, in order) once no point
+/// that may still need it remains to be finalised; then it leaves the
+/// window.  The window holds at most the points of a slab of thickness 3r
+/// plus one batch and one read (min(batch, 65536) points): memory does not
+/// grow with the cloud.
+///
+/// Unlike the reference code, which locks grid cells, the sweep works in
+/// phases: a batch of points is finalised with one CGAL kd-tree built over
+/// the window and queried in parallel (read only, no locks), then the
+/// visitor runs sequentially in the sweep order.  The result is the same
+/// for any number of threads.  The k nearest neighbours are those of the
+/// whole cloud for every neighbour closer than r (the points left out of
+/// the window are all farther), so the graph is exactly the in-core graph,
+/// up to ties in distance.
+///
+/// \tparam ConcurrencyTag `CGAL::Parallel_tag` or `CGAL::Sequential_tag`
+/// \tparam Kernel a CGAL kernel (for its `Point_3` and search traits)
+/// \throw std::invalid_argument if r is not > 0 and finite or k < 1
+/// \throw std::runtime_error if the keys are not sorted or not finite (the
+///        message names the point)
+template <typename ConcurrencyTag, typename Kernel, typename Source, typename KeyFunction, typename Visitor,
+          typename Payload>
+Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options, Visitor& visitor,
+                   Sweep_window<Payload>& window)
+{
+  typedef typename Kernel::Point_3 Point;
+  typedef CGAL::Search_traits_3<Kernel> Base_traits;
+  typedef CGAL::Pointer_property_map<Point> Pmap_factory;
+  typedef typename Pmap_factory::const_type Point_pmap;
+  typedef CGAL::Search_traits_adapter<std::uint32_t, Point_pmap, Base_traits> Traits;
+  typedef CGAL::Sliding_midpoint<Traits> Splitter;
+  typedef CGAL::Distance_adapter<std::uint32_t, Point_pmap, CGAL::Euclidean_distance<Base_traits>> Distance;
+  typedef CGAL::Kd_tree<Traits, Splitter, CGAL::Tag_true, CGAL::Tag_true> Tree;
+  typedef CGAL::Orthogonal_k_neighbor_search<Traits, Distance, Splitter, Tree> Search;
+
+  const double r = options.radius;
+  const unsigned int k = options.number_of_neighbors;
+  if (!(r > 0.0) || !std::isfinite(r))
+    throw std::invalid_argument("sweep: the radius must be a finite number > 0");
+  if (k < 1)
+    throw std::invalid_argument("sweep: the number of neighbors must be at least 1");
+  const double r2 = r * r;
+  const std::size_t batch = std::max<std::size_t>(1, options.batch_size);
+  const std::size_t read_size = std::max<std::size_t>(64, std::min<std::size_t>(batch, 65536));
+
+  Sweep_report report;
+  auto& slots = window.m_slots;
+  std::uint64_t finalized = window.m_base + slots.size(); // the next point to finalise
+  std::uint64_t read_count = 0;
+  double last_key = -std::numeric_limits<double>::infinity();
+  bool at_end = false;
+  std::vector<Point_record> chunk;
+
+  // reverse edges: (later end, earlier end, squared distance)
+  struct Reverse
+  {
+    std::uint64_t target, source;
+    float squared_distance;
+  };
+  std::vector<Reverse> reverse;
+  std::vector<Point> points;
+  std::vector<std::uint32_t> knn;
+  std::vector<float> knn_d2;
+  std::vector<Sweep_neighbor> earlier;
+
+  while (true) {
+    // 1. Read until a batch can be finalised (or the input ends).
+    auto finalizable = [&]() -> std::uint64_t { // one past the last point that may be finalised
+      if (at_end)
+        return window.m_base + slots.size();
+      std::uint64_t e = finalized;
+      while (e < window.m_base + slots.size() && slots[std::size_t(e - window.m_base)].key + r <= last_key)
+        ++e;
+      return e;
+    };
+    std::uint64_t ready = finalizable();
+    while (!at_end && ready - finalized < batch) {
+      chunk.clear();
+      const std::size_t got = source.read(chunk, read_size);
+      if (got == 0) {
+        at_end = true;
+        break;
+      }
+      for (const Point_record& p : chunk) {
+        const double kp = double(key(p));
+        if (!std::isfinite(kp) || kp < last_key) {
+          std::ostringstream msg;
+          msg << "sweep: the input is not sorted along the sweep axis at point " << read_count << " (input index "
+              << p.index << ")";
+          throw std::runtime_error(msg.str());
+        }
+        last_key = kp;
+        slots.push_back(typename Sweep_window<Payload>::Slot{p, kp, Payload()});
+        ++read_count;
+      }
+      report.peak_window = std::max(report.peak_window, slots.size());
+      ready = finalizable();
+    }
+    ready = finalizable();
+    if (ready == finalized) {
+      if (at_end)
+        break;
+      continue;
+    }
+
+    // 2. kNN of the points [finalized, ready) over the window.
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::size_t w = slots.size();
+    points.resize(w);
+    for (std::size_t s = 0; s < w; ++s)
+      points[s] = Point(slots[s].record.position[0], slots[s].record.position[1], slots[s].record.position[2]);
+    const Point_pmap pmap = CGAL::make_property_map(static_cast<const std::vector<Point>&>(points));
+    Tree tree(boost::counting_iterator<std::uint32_t>(0), boost::counting_iterator<std::uint32_t>(std::uint32_t(w)),
+              Splitter(), Traits(pmap));
+    tree.template build<ConcurrencyTag>();
+    const Distance distance(pmap);
+    const std::size_t first_slot = std::size_t(finalized - window.m_base);
+    const std::size_t count = std::size_t(ready - finalized);
+    knn.assign(count * k, ~std::uint32_t(0));
+    knn_d2.assign(count * k, 0.f);
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
+      for (std::size_t q = b; q < e; ++q) {
+        const std::uint32_t i = std::uint32_t(first_slot + q);
+        Search search(tree, points[i], k + 1, 0, true, distance, true);
+        unsigned int t = 0;
+        bool self_skipped = false;
+        for (auto it = search.begin(); it != search.end() && t < k; ++it) {
+          if (!self_skipped && it->first == i) {
+            self_skipped = true;
+            continue;
+          }
+          knn[q * k + t] = it->first;
+          knn_d2[q * k + t] = float(CGAL::to_double(it->second));
+          ++t;
+        }
+      }
+    }, 256);
+    report.seconds_neighbors += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++report.number_of_batches;
+
+    // 3. Reverse edges from this batch to later points.
+    for (std::size_t q = 0; q < count; ++q)
+      for (unsigned int t = 0; t < k; ++t) {
+        const std::uint32_t j = knn[q * k + t];
+        if (j == ~std::uint32_t(0) || !(double(knn_d2[q * k + t]) < r2))
+          continue;
+        const std::uint64_t sj = window.m_base + j, sp = finalized + q;
+        if (sj > sp)
+          reverse.push_back({sj, sp, knn_d2[q * k + t]});
+      }
+    std::sort(reverse.begin(), reverse.end(), [](const Reverse& a, const Reverse& b) {
+      return a.target != b.target ? a.target < b.target : a.source < b.source;
+    });
+
+    // 4. Finalise in order.
+    std::size_t rv = 0;
+    for (std::size_t q = 0; q < count; ++q) {
+      const std::uint64_t sp = finalized + q;
+      earlier.clear();
+      for (unsigned int t = 0; t < k; ++t) {
+        const std::uint32_t j = knn[q * k + t];
+        if (j == ~std::uint32_t(0) || !(double(knn_d2[q * k + t]) < r2))
+          continue;
+        const std::uint64_t sj = window.m_base + j;
+        if (sj < sp)
+          earlier.push_back({sj, knn_d2[q * k + t]});
+      }
+      while (rv < reverse.size() && reverse[rv].target < sp)
+        ++rv; // cannot happen: targets are later than every finalised point
+      while (rv < reverse.size() && reverse[rv].target == sp) {
+        earlier.push_back({reverse[rv].source, reverse[rv].squared_distance});
+        ++rv;
+      }
+      std::sort(earlier.begin(), earlier.end(),
+                [](const Sweep_neighbor& a, const Sweep_neighbor& b) { return a.sequence < b.sequence; });
+      earlier.erase(std::unique(earlier.begin(), earlier.end(),
+                                [](const Sweep_neighbor& a, const Sweep_neighbor& b) { return a.sequence == b.sequence; }),
+                    earlier.end());
+      report.number_of_edges += earlier.size();
+      visitor.finalize(window, sp, earlier);
+    }
+    reverse.erase(reverse.begin(), reverse.begin() + std::ptrdiff_t(rv));
+    finalized = ready;
+    report.number_of_points += count;
+
+    // 5. Release the points that no point still to finalise can need: the
+    //    first unfinalised point, or the next one to be read, has a key at
+    //    least `limit`.
+    const bool all_done = finalized == window.m_base + slots.size();
+    const double limit = !all_done ? slots[std::size_t(finalized - window.m_base)].key
+                                   : at_end ? std::numeric_limits<double>::infinity() : last_key;
+    while (!slots.empty() && window.m_base < finalized && slots.front().key + r <= limit) {
+      visitor.release(window, window.m_base);
+      slots.pop_front();
+      ++window.m_base;
+    }
+    if (at_end && all_done)
+      break;
+  }
+  return report;
+}
+
+} // namespace streaming
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_STREAMING_SWEEP_H

@@ -1,0 +1,957 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_STREAMING_EXTERNAL_SORT_H
+#define NORMAL_ORIENTATION_STREAMING_EXTERNAL_SORT_H
+
+/// \file external_sort.h
+/// Sorting a streamed point cloud along its sweep axis with bounded memory.
+///
+/// The streaming (out-of-core) pipeline sweeps the cloud along the principal
+/// axis of largest variance.  This header provides
+/// - `Sweep_frame` and `compute_sweep_frame()`: the centroid and a right-handed
+///   orthonormal basis (axis, u, v) of the cloud, computed in one streaming pass;
+/// - `External_sorter` (and the shortcut `external_sort()`): sorts all records of
+///   a source by (key along the axis, index) with bounded memory: sorted runs
+///   written to temporary files, merged lazily by a `Sorted_run_reader`, which is
+///   itself a source;
+/// - `remove_temporary_files()`: an async-signal-safe clean-up for signal handlers.
+///
+/// **The Source concept.**  A source of `Point_record`s is any object `s` with
+/// - `std::size_t s.read(std::vector<Point_record>& chunk, std::size_t maximum)`:
+///   appends up to `maximum` records to `chunk` and returns how many (0 at the end);
+/// - `void s.rewind()`: starts again from the first record.
+///
+/// The records are never transformed: positions and normals come out of the sort
+/// bit-identical, in the input coordinate frame.
+///
+/// POSIX only (`mkstemp`, `pread`, `unlink`).
+
+#include <Normal_orientation/streaming/Point_record.h>
+
+#if !defined(__unix__) && !defined(__APPLE__)
+#error "Normal_orientation/streaming/external_sort.h needs POSIX (mkstemp, pread, unlink)"
+#endif
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <utility>
+#include <vector>
+
+#include <fcntl.h>
+#include <sys/types.h>
+#include <unistd.h>
+
+namespace Normal_orientation {
+namespace streaming {
+
+// ---------------------------------------------------------------------------
+// Sweep frame
+// ---------------------------------------------------------------------------
+
+/// \ingroup PkgNormalOrientationStreaming
+/// The frame of a sweep: the centroid `c` of the cloud and a right-handed
+/// orthonormal basis (`axis`, `u`, `v`), `axis` being the principal direction of
+/// largest variance and `u` the second one.  The sweep visits the points by
+/// increasing `key(p) = dot(p - c, axis)`; `uv(p)` gives their coordinates in the
+/// plane orthogonal to the axis (for a 2-D grid).  The frame only *reads*
+/// positions: the records themselves are never moved to this frame.
+///
+/// For degenerate clouds (empty, one point, identical, collinear or planar
+/// points) the frame is still orthonormal, right-handed and deterministic; for
+/// an empty cloud it is the canonical frame at the origin.
+struct Sweep_frame
+{
+  /// the centroid of the (finite) points
+  std::array<double, 3> centroid{{0., 0., 0.}};
+  /// the sweep axis: the unit principal direction of largest variance, its
+  /// largest absolute component positive (ties: the first one)
+  std::array<double, 3> axis{{1., 0., 0.}};
+  /// the unit principal direction of second largest variance, orthogonal to
+  /// `axis`, its largest absolute component positive (ties: the first one)
+  std::array<double, 3> u{{0., 1., 0.}};
+  /// `axis` x `u`, so that (axis, u, v) is right-handed
+  std::array<double, 3> v{{0., 0., 1.}};
+  /// the variances along `axis`, `u` and `v` (eigenvalues of the population
+  /// covariance, in decreasing order)
+  std::array<double, 3> variances{{0., 0., 0.}};
+  /// the number of records read
+  std::uint64_t size = 0;
+  /// the number of records ignored because a coordinate is not finite (their
+  /// key is NaN; the sort puts them last)
+  std::uint64_t non_finite = 0;
+
+  /// the sweep key of `r`: dot(position - centroid, axis)
+  double key(const Point_record& r) const
+  {
+    const double dx = r.position[0] - centroid[0];
+    const double dy = r.position[1] - centroid[1];
+    const double dz = r.position[2] - centroid[2];
+    const double kx = dx * axis[0];
+    const double ky = dy * axis[1];
+    const double kz = dz * axis[2];
+    return (kx + ky) + kz;
+  }
+
+  /// the coordinate of `r` along `u`: dot(position - centroid, u)
+  double u_coordinate(const Point_record& r) const { return project(r, u); }
+
+  /// the coordinate of `r` along `v`: dot(position - centroid, v)
+  double v_coordinate(const Point_record& r) const { return project(r, v); }
+
+  /// the coordinates (u, v) of `r` in the plane orthogonal to the axis
+  std::array<double, 2> uv(const Point_record& r) const
+  {
+    return {{u_coordinate(r), v_coordinate(r)}};
+  }
+
+private:
+  double project(const Point_record& r, const std::array<double, 3>& d) const
+  {
+    const double dx = r.position[0] - centroid[0];
+    const double dy = r.position[1] - centroid[1];
+    const double dz = r.position[2] - centroid[2];
+    return (dx * d[0] + dy * d[1]) + dz * d[2];
+  }
+};
+
+namespace internal {
+
+/// Eigen-decomposition of a symmetric 3x3 matrix `m` by cyclic Jacobi
+/// rotations: `values[k]` is the eigenvalue of the unit eigenvector stored in
+/// column `k` of `vectors` (vectors[row][k]).  Deterministic; orthogonal output.
+inline void symmetric_eigen_3(const double (&m)[3][3], double (&values)[3], double (&vectors)[3][3])
+{
+  double a[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      a[i][j] = 0.5 * (m[i][j] + m[j][i]);
+      vectors[i][j] = (i == j) ? 1. : 0.;
+    }
+  static const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+  for (int sweep = 0; sweep < 64; ++sweep) {
+    const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+    const double diagonal = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+    if (!(off > 1e-34 * diagonal)) // also stops on zero or non-finite matrices
+      break;
+    for (const auto& pq : pairs) {
+      const int p = pq[0], q = pq[1];
+      if (a[p][q] == 0.)
+        continue;
+      // rotation J (J_pp = J_qq = c, J_pq = s, J_qp = -s) with (J^T A J)_pq = 0:
+      // t = tan(phi) is the smaller root of t^2 + 2 theta t - 1 = 0
+      const double theta = (a[q][q] - a[p][p]) / (2. * a[p][q]);
+      double t;
+      if (std::abs(theta) > 1e150)
+        t = 0.5 / theta;
+      else
+        t = (theta >= 0. ? 1. : -1.) / (std::abs(theta) + std::sqrt(theta * theta + 1.));
+      const double c = 1. / std::sqrt(t * t + 1.);
+      const double s = t * c;
+      double j[3][3] = {{1., 0., 0.}, {0., 1., 0.}, {0., 0., 1.}};
+      j[p][p] = c;
+      j[q][q] = c;
+      j[p][q] = s;
+      j[q][p] = -s;
+      double aj[3][3], jtaj[3][3], vj[3][3];
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) {
+          aj[r][k] = a[r][0] * j[0][k] + a[r][1] * j[1][k] + a[r][2] * j[2][k];
+          vj[r][k] = vectors[r][0] * j[0][k] + vectors[r][1] * j[1][k] + vectors[r][2] * j[2][k];
+        }
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k)
+          jtaj[r][k] = j[0][r] * aj[0][k] + j[1][r] * aj[1][k] + j[2][r] * aj[2][k];
+      for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) {
+          a[r][k] = (r == k) ? jtaj[r][k] : 0.5 * (jtaj[r][k] + jtaj[k][r]);
+          vectors[r][k] = vj[r][k];
+        }
+      a[p][q] = a[q][p] = 0.;
+    }
+  }
+  for (int k = 0; k < 3; ++k)
+    values[k] = a[k][k];
+}
+
+/// normalizes `d`; returns false if its length is zero or not finite
+inline bool normalize(std::array<double, 3>& d)
+{
+  const double length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  if (!(length > 0.) || !std::isfinite(length))
+    return false;
+  for (double& x : d)
+    x /= length;
+  return true;
+}
+
+/// flips `d` so that its largest absolute component (the first one on ties) is positive
+inline void make_sign_canonical(std::array<double, 3>& d)
+{
+  int largest = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(d[k]) > std::abs(d[largest]))
+      largest = k;
+  if (d[largest] < 0.)
+    for (double& x : d)
+      x = -x;
+}
+
+/// the cross product a x b
+inline std::array<double, 3> cross(const std::array<double, 3>& a, const std::array<double, 3>& b)
+{
+  return {{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
+}
+
+/// Streaming accumulator of the count, the centroid and the covariance of
+/// positions (Welford's update, numerically stable for far-from-origin clouds).
+/// Records with a non-finite coordinate are counted but otherwise ignored.
+class Moment_accumulator
+{
+public:
+  /// adds one record
+  void add(const Point_record& r)
+  {
+    ++m_size;
+    const double* p = r.position;
+    if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) {
+      ++m_non_finite;
+      return;
+    }
+    ++m_count;
+    const double n = double(m_count);
+    double delta[3], delta_after[3];
+    for (int i = 0; i < 3; ++i) {
+      delta[i] = p[i] - m_mean[i];
+      m_mean[i] += delta[i] / n;
+      delta_after[i] = p[i] - m_mean[i];
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j)
+        m_m2[i][j] += delta[i] * delta_after[j];
+  }
+
+  /// the frame of the records added so far
+  Sweep_frame frame() const
+  {
+    Sweep_frame f;
+    f.size = m_size;
+    f.non_finite = m_non_finite;
+    if (m_count == 0)
+      return f;
+    for (int i = 0; i < 3; ++i)
+      f.centroid[i] = m_mean[i];
+    double covariance[3][3];
+    bool finite = true;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        covariance[i][j] = (i <= j ? m_m2[i][j] : m_m2[j][i]) / double(m_count);
+        finite = finite && std::isfinite(covariance[i][j]);
+      }
+    if (!finite) // overflow (coordinates beyond ~1e150): keep the canonical basis
+      return f;
+    double values[3], vectors[3][3];
+    symmetric_eigen_3(covariance, values, vectors);
+    int order[3] = {0, 1, 2};
+    std::stable_sort(order, order + 3, [&](int a, int b) { return values[a] > values[b]; });
+    std::array<double, 3> axis{{vectors[0][order[0]], vectors[1][order[0]], vectors[2][order[0]]}};
+    std::array<double, 3> u{{vectors[0][order[1]], vectors[1][order[1]], vectors[2][order[1]]}};
+    if (!normalize(axis))
+      return f;
+    make_sign_canonical(axis);
+    // re-orthogonalize u against the axis (Jacobi's vectors are orthogonal up to rounding)
+    const double along = u[0] * axis[0] + u[1] * axis[1] + u[2] * axis[2];
+    for (int i = 0; i < 3; ++i)
+      u[i] -= along * axis[i];
+    if (!normalize(u)) { // cannot happen with an orthogonal Jacobi output; be safe anyway
+      int smallest = 0;
+      for (int k = 1; k < 3; ++k)
+        if (std::abs(axis[k]) < std::abs(axis[smallest]))
+          smallest = k;
+      std::array<double, 3> e{{0., 0., 0.}};
+      e[smallest] = 1.;
+      u = cross(axis, e);
+      normalize(u);
+    }
+    make_sign_canonical(u);
+    f.axis = axis;
+    f.u = u;
+    f.v = cross(axis, u);
+    normalize(f.v);
+    for (int k = 0; k < 3; ++k)
+      f.variances[k] = std::max(0., values[order[k]]);
+    return f;
+  }
+
+private:
+  std::uint64_t m_size = 0;
+  std::uint64_t m_non_finite = 0;
+  std::uint64_t m_count = 0;
+  double m_mean[3] = {0., 0., 0.};
+  double m_m2[3][3] = {{0., 0., 0.}, {0., 0., 0.}, {0., 0., 0.}};
+};
+
+} // namespace internal
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Computes the sweep frame of all records of `source` in one streaming pass,
+/// reading chunks of at most `chunk_records` records.  Rewinds the source
+/// before and after the pass.  Memory: one chunk.
+template <class Source>
+Sweep_frame compute_sweep_frame(Source& source, std::size_t chunk_records = 65536)
+{
+  chunk_records = std::max<std::size_t>(chunk_records, 1);
+  source.rewind();
+  internal::Moment_accumulator accumulator;
+  std::vector<Point_record> chunk;
+  chunk.reserve(chunk_records);
+  for (;;) {
+    chunk.clear();
+    const std::size_t n = source.read(chunk, chunk_records);
+    if (n == 0)
+      break;
+    if (n != chunk.size())
+      throw std::logic_error("compute_sweep_frame: the source's read() returned a wrong count");
+    for (const Point_record& r : chunk)
+      accumulator.add(r);
+  }
+  source.rewind();
+  return accumulator.frame();
+}
+
+// ---------------------------------------------------------------------------
+// Temporary files
+// ---------------------------------------------------------------------------
+
+namespace internal {
+
+/// the number of temporary files that `remove_temporary_files()` can reach at once
+constexpr std::size_t temporary_file_slot_count = 512;
+/// the longest path (with its final NUL) that `remove_temporary_files()` can reach
+constexpr std::size_t temporary_file_path_capacity = 512;
+
+static_assert(std::atomic<int>::is_always_lock_free, "signal handlers need lock-free atomics");
+
+/// One entry of the process-wide registry of temporary files; `state` is
+/// 0 (free), 1 (being filled or released), 2 (active), 3 (removed by
+/// `remove_temporary_files()`).
+struct Temporary_file_slot
+{
+  /// the state of the slot (see above)
+  std::atomic<int> state;
+  /// the path, NUL-terminated
+  char path[temporary_file_path_capacity];
+};
+
+/// The registry: a fixed array in static storage (zero-initialized, no dynamic
+/// initialization), so that a signal handler can walk it.
+inline Temporary_file_slot temporary_file_slots[temporary_file_slot_count];
+
+/// registers `path`; returns its slot, or -1 if the registry is full or the path too long
+inline int register_temporary_file(const std::string& path) noexcept
+{
+  if (path.size() >= temporary_file_path_capacity)
+    return -1;
+  for (std::size_t i = 0; i < temporary_file_slot_count; ++i) {
+    int expected = 0;
+    if (temporary_file_slots[i].state.compare_exchange_strong(expected, 1, std::memory_order_acq_rel)) {
+      std::memcpy(temporary_file_slots[i].path, path.c_str(), path.size() + 1);
+      temporary_file_slots[i].state.store(2, std::memory_order_release);
+      return int(i);
+    }
+  }
+  return -1;
+}
+
+/// frees `slot` (from `register_temporary_file()`, or -1)
+inline void unregister_temporary_file(int slot) noexcept
+{
+  if (slot >= 0)
+    temporary_file_slots[slot].state.store(0, std::memory_order_release);
+}
+
+/// writes `bytes` bytes to `fd`, throwing `std::system_error` on failure
+inline void write_all(int fd, const void* data, std::size_t bytes, const std::string& path)
+{
+  const char* p = static_cast<const char*>(data);
+  while (bytes > 0) {
+    const ::ssize_t n = ::write(fd, p, std::min<std::size_t>(bytes, std::size_t(1) << 30));
+    if (n < 0) {
+      if (errno == EINTR)
+        continue;
+      throw std::system_error(errno, std::generic_category(), "external sort: cannot write " + path);
+    }
+    if (n == 0)
+      throw std::system_error(ENOSPC, std::generic_category(), "external sort: cannot write " + path);
+    p += n;
+    bytes -= std::size_t(n);
+  }
+}
+
+/// A temporary record file: created with `mkstemp()` in a directory, registered
+/// for `remove_temporary_files()`, removed by the destructor (RAII).  Records
+/// are appended, then read at any position with `pread()` (no shared offset).
+class Temporary_file
+{
+public:
+  /// creates an empty file `directory`/normal_orientation_sort_XXXXXX; if
+  /// `unlink_now`, removes its name at once (the data lives while the file is open)
+  Temporary_file(const std::string& directory, bool unlink_now)
+  {
+    std::string name = directory.empty() ? std::string("/tmp") : directory;
+    if (name.back() != '/')
+      name += '/';
+    name += "normal_orientation_sort_XXXXXX";
+    m_path = name; // allocated before the file exists: nothing can leak after mkstemp()
+    m_fd = ::mkstemp(&m_path[0]);
+    if (m_fd < 0)
+      throw std::system_error(errno, std::generic_category(),
+                              "external sort: cannot create a temporary file " + name);
+    if (unlink_now) {
+      ::unlink(m_path.c_str());
+      m_unlinked = true;
+    }
+    else
+      m_slot = register_temporary_file(m_path);
+  }
+
+  Temporary_file(const Temporary_file&) = delete;
+  Temporary_file& operator=(const Temporary_file&) = delete;
+
+  /// closes and removes the file
+  ~Temporary_file()
+  {
+    if (!m_unlinked) {
+      // a handler may have removed it already (state 3): then leave the name alone
+      const bool removed_by_handler =
+        m_slot >= 0 && temporary_file_slots[m_slot].state.load(std::memory_order_acquire) == 3;
+      if (!removed_by_handler)
+        ::unlink(m_path.c_str());
+      unregister_temporary_file(m_slot);
+    }
+    if (m_fd >= 0)
+      ::close(m_fd);
+  }
+
+  /// appends `n` records stored as bytes at `records` (n * 56 bytes)
+  void append(const void* records, std::size_t n)
+  {
+    write_all(m_fd, records, n * sizeof(Point_record), m_path);
+    m_size += n;
+  }
+
+  /// reads up to `n` records from record `first` on; returns how many
+  std::size_t read(Point_record* records, std::size_t n, std::uint64_t first) const
+  {
+    if (first >= m_size)
+      return 0;
+    n = std::size_t(std::min<std::uint64_t>(n, m_size - first));
+    char* p = reinterpret_cast<char*>(records);
+    std::size_t bytes = n * sizeof(Point_record);
+    std::uint64_t offset = first * sizeof(Point_record);
+    while (bytes > 0) {
+      const ::ssize_t got = ::pread(m_fd, p, bytes, ::off_t(offset));
+      if (got < 0) {
+        if (errno == EINTR)
+          continue;
+        throw std::system_error(errno, std::generic_category(), "external sort: cannot read " + m_path);
+      }
+      if (got == 0)
+        throw std::runtime_error("external sort: " + m_path + " is shorter than written");
+      p += got;
+      bytes -= std::size_t(got);
+      offset += std::uint64_t(got);
+    }
+    return n;
+  }
+
+  /// the number of records written
+  std::uint64_t size() const { return m_size; }
+  /// the path of the file
+  const std::string& path() const { return m_path; }
+
+private:
+  int m_fd = -1;
+  int m_slot = -1;
+  bool m_unlinked = false;
+  std::uint64_t m_size = 0;
+  std::string m_path;
+};
+
+/// a record with its sweep key, the unit of the in-memory run sort (64 bytes)
+struct Keyed_record
+{
+  /// the sweep key of `record`
+  double key;
+  /// the record
+  Point_record record;
+};
+
+/// the sort order: by key (NaN keys last, all equal), then by index.  A strict
+/// weak order even with NaN keys.
+inline bool key_index_less(double key_a, std::uint64_t index_a, double key_b, std::uint64_t index_b)
+{
+  const bool nan_a = std::isnan(key_a), nan_b = std::isnan(key_b);
+  if (nan_a != nan_b)
+    return nan_b;
+  if (!nan_a) {
+    if (key_a < key_b)
+      return true;
+    if (key_b < key_a)
+      return false;
+  }
+  return index_a < index_b;
+}
+
+/// Lazy k-way merge of sorted run files (a binary heap of the run heads): a
+/// source of the merged sequence.  Ties on (key, index) are broken by run order.
+class Run_merger
+{
+public:
+  /// merges `runs` (not owned; they must outlive the merger), buffering up to
+  /// `buffer_records` records of each run
+  Run_merger(std::vector<const Temporary_file*> runs, const Sweep_frame& frame, std::size_t buffer_records)
+    : m_frame(frame), m_buffer_records(std::max<std::size_t>(buffer_records, 1))
+  {
+    m_cursors.resize(runs.size());
+    for (std::size_t i = 0; i < runs.size(); ++i)
+      m_cursors[i].file = runs[i];
+    rewind();
+  }
+
+  /// starts again from the first record
+  void rewind()
+  {
+    m_heap.clear();
+    for (std::size_t i = 0; i < m_cursors.size(); ++i) {
+      Cursor& c = m_cursors[i];
+      c.next_record = 0;
+      if (refill(c))
+        m_heap.push_back(head(i));
+    }
+    std::make_heap(m_heap.begin(), m_heap.end(), Head_greater());
+  }
+
+  /// appends up to `maximum` merged records to `chunk`; returns how many
+  std::size_t read(std::vector<Point_record>& chunk, std::size_t maximum)
+  {
+    std::size_t produced = 0;
+    while (produced < maximum && !m_heap.empty()) {
+      std::pop_heap(m_heap.begin(), m_heap.end(), Head_greater());
+      const std::size_t run = m_heap.back().run;
+      m_heap.pop_back();
+      Cursor& c = m_cursors[run];
+      chunk.push_back(c.buffer[c.position]);
+      ++c.position;
+      ++produced;
+      if (c.position == c.buffer.size() && !refill(c))
+        continue;
+      m_heap.push_back(head(run));
+      std::push_heap(m_heap.begin(), m_heap.end(), Head_greater());
+    }
+    return produced;
+  }
+
+private:
+  /// a run being read: its file, a buffer of its next records and where they come from
+  struct Cursor
+  {
+    const Temporary_file* file = nullptr;
+    std::vector<Point_record> buffer;
+    std::size_t position = 0;
+    std::uint64_t next_record = 0;
+  };
+  /// the first unread record of a run, as ordered in the heap
+  struct Head
+  {
+    double key;
+    std::uint64_t index;
+    std::size_t run;
+  };
+  /// the heap order (a min-heap on (key, index, run))
+  struct Head_greater
+  {
+    bool operator()(const Head& a, const Head& b) const
+    {
+      if (key_index_less(b.key, b.index, a.key, a.index))
+        return true;
+      if (key_index_less(a.key, a.index, b.key, b.index))
+        return false;
+      return a.run > b.run;
+    }
+  };
+
+  bool refill(Cursor& c)
+  {
+    const std::uint64_t left = c.file->size() - c.next_record;
+    const std::size_t n = std::size_t(std::min<std::uint64_t>(left, m_buffer_records));
+    c.buffer.resize(n);
+    c.position = 0;
+    if (n == 0) {
+      c.buffer.shrink_to_fit();
+      return false;
+    }
+    c.file->read(c.buffer.data(), n, c.next_record);
+    c.next_record += n;
+    return true;
+  }
+
+  Head head(std::size_t run) const
+  {
+    const Point_record& r = m_cursors[run].buffer[m_cursors[run].position];
+    return Head{m_frame.key(r), r.index, run};
+  }
+
+  Sweep_frame m_frame;
+  std::size_t m_buffer_records;
+  std::vector<Cursor> m_cursors;
+  std::vector<Head> m_heap;
+};
+
+/// the temporary directory: `requested` if not empty, else `$TMPDIR` if set and
+/// not empty, else /tmp
+inline std::string temporary_directory(const std::string& requested)
+{
+  if (!requested.empty())
+    return requested;
+  const char* tmpdir = std::getenv("TMPDIR");
+  if (tmpdir != nullptr && tmpdir[0] != '\0')
+    return tmpdir;
+  return "/tmp";
+}
+
+} // namespace internal
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Removes every temporary file of every live `External_sorter` /
+/// `Sorted_run_reader` of the process, and returns how many names were unlinked.
+///
+/// **Async-signal-safe**: it only walks a fixed array of C strings in static
+/// storage with lock-free atomics and calls `unlink()`, so a handler of
+/// SIGINT/SIGTERM may call it before `_exit()`.  The owners are not told;
+/// after it, the sorted data is lost (open descriptors still work, but do not
+/// rely on it: call it only when the process is about to end).  Files created
+/// while the registry (512 entries) is full, or with a path of 512 bytes or
+/// more, are not reachable from here (they are still removed by their owner).
+inline std::size_t remove_temporary_files() noexcept
+{
+  std::size_t removed = 0;
+  for (std::size_t i = 0; i < internal::temporary_file_slot_count; ++i) {
+    internal::Temporary_file_slot& slot = internal::temporary_file_slots[i];
+    int expected = 2;
+    if (slot.state.compare_exchange_strong(expected, 3, std::memory_order_acq_rel))
+      if (::unlink(slot.path) == 0)
+        ++removed;
+  }
+  return removed;
+}
+
+// ---------------------------------------------------------------------------
+// External sort
+// ---------------------------------------------------------------------------
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Options of `External_sorter`.
+struct External_sort_options
+{
+  /// bytes of records sorted in memory at once (a run, at least 16 records);
+  /// each record takes 64 bytes then.  The merge buffers of the reader share
+  /// this budget too (at least 64 records per run).  Peak memory of the sort:
+  /// about 1.25 times this (intermediate merges use a quarter of the budget
+  /// while the run buffer is kept) plus 0.5 MiB.
+  std::size_t memory_budget = std::size_t(256) << 20;
+  /// where temporary files go; empty: `$TMPDIR` if set, else /tmp
+  std::string temporary_directory;
+  /// the most runs merged at once (at least 2); more runs are merged in
+  /// intermediate passes, which bounds the number of open files
+  std::size_t max_merge_fan_in = 64;
+  /// when everything fits in one run, keep it in memory (no file at all)
+  bool keep_single_run_in_memory = true;
+  /// remove the name of every temporary file right after creating it: nothing
+  /// can be left behind, even after SIGKILL, but the files are then invisible
+  /// (and `remove_temporary_files()` has nothing to do)
+  bool unlink_on_creation = false;
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Figures of one external sort.
+struct External_sort_report
+{
+  /// the number of records sorted
+  std::uint64_t points = 0;
+  /// the number of sorted runs produced from the source (1 when it fits in memory)
+  std::size_t runs = 0;
+  /// the number of intermediate merge passes (each merges `max_merge_fan_in` runs)
+  std::size_t intermediate_merges = 0;
+  /// the number of runs merged by the reader (0 when the single run is kept in memory)
+  std::size_t merged_runs = 0;
+  /// bytes written to temporary files (runs and intermediate merges)
+  std::uint64_t bytes_written = 0;
+  /// wall-clock seconds of the sort (reading the source, sorting runs, writing
+  /// them, intermediate merges; not the final merge, which happens as the
+  /// reader is read)
+  double seconds = 0.;
+  /// the directory of the temporary files
+  std::string temporary_directory;
+};
+
+class External_sorter;
+
+/// \ingroup PkgNormalOrientationStreaming
+/// The sorted records, read sequentially: a source (`read()`, `rewind()`)
+/// whose records come by increasing (`frame().key()`, index), NaN keys last.
+/// It owns the temporary files of the sort and removes them when destroyed.
+/// Move-only.  Made by `External_sorter::sort()` (or `external_sort()`).
+class Sorted_run_reader
+{
+public:
+  /// an empty reader
+  Sorted_run_reader() = default;
+  /// moves
+  Sorted_run_reader(Sorted_run_reader&&) = default;
+  /// moves (the temporary files of `*this` are removed)
+  Sorted_run_reader& operator=(Sorted_run_reader&&) = default;
+
+  /// appends up to `maximum` records to `chunk`, in sorted order; returns how many (0 at the end)
+  std::size_t read(std::vector<Point_record>& chunk, std::size_t maximum)
+  {
+    if (m_merger)
+      return m_merger->read(chunk, maximum);
+    const std::size_t n = std::min(maximum, m_memory.size() - m_memory_position);
+    for (std::size_t i = 0; i < n; ++i)
+      chunk.push_back(m_memory[m_memory_position + i].record);
+    m_memory_position += n;
+    return n;
+  }
+
+  /// starts again from the first record
+  void rewind()
+  {
+    if (m_merger)
+      m_merger->rewind();
+    m_memory_position = 0;
+  }
+
+  /// the number of records
+  std::uint64_t size() const { return m_report.points; }
+  /// the frame whose keys order the records
+  const Sweep_frame& frame() const { return m_frame; }
+  /// the figures of the sort
+  const External_sort_report& report() const { return m_report; }
+  /// the number of temporary files held (0 when the records are in memory)
+  std::size_t number_of_temporary_files() const { return m_runs.size(); }
+
+private:
+  friend class External_sorter;
+
+  Sweep_frame m_frame;
+  External_sort_report m_report;
+  std::vector<internal::Keyed_record> m_memory;
+  std::size_t m_memory_position = 0;
+  std::vector<std::unique_ptr<internal::Temporary_file>> m_runs;
+  std::unique_ptr<internal::Run_merger> m_merger; // after m_runs: destroyed first
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Sorts all records of a source by (sweep key, index) with bounded memory.
+///
+/// The source is read in runs of at most `memory_budget / 64` records; each run
+/// is sorted in memory (`std::sort` of (key, record) pairs) and written to a
+/// temporary file (`mkstemp()` in the temporary directory).  Whenever
+/// `max_merge_fan_in` runs of the same level exist they are merged into one
+/// (intermediate passes, like a log-structured merge), so at most about
+/// `max_merge_fan_in * levels` files exist at once.  The final k-way merge is
+/// not written: the returned `Sorted_run_reader` performs it as it is read.
+/// When everything fits in one run, it stays in memory and no file is written
+/// (unless `keep_single_run_in_memory` is false).
+///
+/// Temporary files are owned by RAII objects: they are removed when the reader
+/// is destroyed, and at once if the sort fails (the source throws, a write
+/// fails: the exception propagates).  `remove_temporary_files()` removes them
+/// from a signal handler.  The output is deterministic.
+class External_sorter
+{
+public:
+  /// a sorter with `options`
+  explicit External_sorter(External_sort_options options = External_sort_options())
+    : m_options(std::move(options))
+  {}
+
+  /// the options
+  const External_sort_options& options() const { return m_options; }
+
+  /// sorts the records of `source` (rewound first) by (`frame.key()`, index)
+  template <class Source>
+  Sorted_run_reader sort(Source& source, const Sweep_frame& frame) const
+  {
+    const auto start = std::chrono::steady_clock::now();
+    Sorted_run_reader result;
+    result.m_frame = frame;
+    External_sort_report& report = result.m_report;
+    report.temporary_directory = internal::temporary_directory(m_options.temporary_directory);
+
+    const std::size_t run_capacity =
+      std::max<std::size_t>(m_options.memory_budget / sizeof(internal::Keyed_record), 16);
+    const std::size_t staging_capacity = std::min<std::size_t>(run_capacity, 8192);
+    const std::size_t fan_in = std::max<std::size_t>(m_options.max_merge_fan_in, 2);
+
+    std::vector<Point_record> staging;
+    staging.reserve(staging_capacity);
+    std::vector<internal::Keyed_record> run;
+    run.reserve(staging_capacity);
+    std::vector<Level_run> runs;
+
+    auto write_run = [&]() {
+      std::sort(run.begin(), run.end(), [](const internal::Keyed_record& a, const internal::Keyed_record& b) {
+        return internal::key_index_less(a.key, a.record.index, b.key, b.record.index);
+      });
+      auto file = std::make_unique<internal::Temporary_file>(report.temporary_directory,
+                                                             m_options.unlink_on_creation);
+      // pack the records in place (record i moves from byte 64 i + 8 down to byte 56 i,
+      // never over a record not yet moved), then write them in one go
+      unsigned char* bytes = reinterpret_cast<unsigned char*>(run.data());
+      for (std::size_t i = 0; i < run.size(); ++i)
+        std::memmove(bytes + i * sizeof(Point_record), &run[i].record, sizeof(Point_record));
+      file->append(bytes, run.size());
+      report.bytes_written += file->size() * sizeof(Point_record);
+      ++report.runs;
+      runs.push_back(Level_run{std::move(file), 0});
+      run.clear();
+      collapse(runs, fan_in, fan_in, frame, report, m_options.memory_budget / 4);
+    };
+
+    source.rewind();
+    for (;;) {
+      const std::size_t want =
+        run.size() < run_capacity ? std::min(staging_capacity, run_capacity - run.size()) : staging_capacity;
+      staging.clear();
+      const std::size_t n = source.read(staging, want);
+      if (n == 0)
+        break;
+      if (n != staging.size() || n > want)
+        throw std::logic_error("External_sorter: the source's read() returned a wrong count");
+      report.points += n;
+      if (run.size() == run_capacity)
+        write_run(); // more records than one run: this one goes to a file
+      if (run.capacity() < run.size() + n)
+        run.reserve(run_capacity); // one jump: never more than the budget (plus the first block)
+      for (const Point_record& r : staging)
+        run.push_back(internal::Keyed_record{frame.key(r), r});
+    }
+
+    if (runs.empty() && m_options.keep_single_run_in_memory) {
+      std::sort(run.begin(), run.end(), [](const internal::Keyed_record& a, const internal::Keyed_record& b) {
+        return internal::key_index_less(a.key, a.record.index, b.key, b.record.index);
+      });
+      report.runs = run.empty() ? 0 : 1;
+      result.m_memory = std::move(run);
+    }
+    else {
+      if (!run.empty())
+        write_run();
+      std::vector<internal::Keyed_record>().swap(run);
+      collapse(runs, fan_in, 1, frame, report, m_options.memory_budget); // at most fan_in runs for the reader
+      std::vector<const internal::Temporary_file*> files;
+      for (Level_run& r : runs) {
+        files.push_back(r.file.get());
+        result.m_runs.push_back(std::move(r.file));
+      }
+      report.merged_runs = files.size();
+      result.m_merger = std::make_unique<internal::Run_merger>(
+        std::move(files), frame, merge_buffer_records(report.merged_runs, m_options.memory_budget));
+    }
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return result;
+  }
+
+private:
+  /// a run file and its merge level (0: written from memory)
+  struct Level_run
+  {
+    std::unique_ptr<internal::Temporary_file> file;
+    std::size_t level;
+  };
+
+  /// the records buffered per run when `runs` runs share `budget` bytes
+  static std::size_t merge_buffer_records(std::size_t runs, std::size_t budget)
+  {
+    const std::size_t records = budget / (std::max<std::size_t>(runs, 1) * sizeof(Point_record));
+    return std::min<std::size_t>(std::max<std::size_t>(records, 64), 65536);
+  }
+
+  /// merges the last `fan_in` runs while the last `same_level` (or more) runs
+  /// have the same level (same_level == fan_in), or while there are more than
+  /// `fan_in` runs (same_level == 1); the merge buffers share `budget` bytes
+  void collapse(std::vector<Level_run>& runs, std::size_t fan_in, std::size_t same_level,
+                const Sweep_frame& frame, External_sort_report& report, std::size_t budget) const
+  {
+    std::vector<Point_record> buffer;
+    for (;;) {
+      if (same_level > 1) {
+        if (runs.size() < fan_in)
+          return;
+        const std::size_t level = runs.back().level;
+        std::size_t count = 0;
+        while (count < runs.size() && runs[runs.size() - 1 - count].level == level)
+          ++count;
+        if (count < fan_in)
+          return;
+      }
+      else if (runs.size() <= fan_in)
+        return;
+      const std::size_t first = runs.size() - fan_in;
+      std::vector<const internal::Temporary_file*> files;
+      std::size_t level = 0;
+      for (std::size_t i = first; i < runs.size(); ++i) {
+        files.push_back(runs[i].file.get());
+        level = std::max(level, runs[i].level);
+      }
+      auto merged = std::make_unique<internal::Temporary_file>(report.temporary_directory,
+                                                               m_options.unlink_on_creation);
+      {
+        const std::size_t chunk = merge_buffer_records(fan_in + 1, budget);
+        internal::Run_merger merger(std::move(files), frame, chunk);
+        buffer.reserve(chunk);
+        for (;;) {
+          buffer.clear();
+          const std::size_t n = merger.read(buffer, chunk);
+          if (n == 0)
+            break;
+          merged->append(buffer.data(), n);
+        }
+      }
+      report.bytes_written += merged->size() * sizeof(Point_record);
+      ++report.intermediate_merges;
+      runs.erase(runs.begin() + std::ptrdiff_t(first), runs.end()); // removes the merged files
+      runs.push_back(Level_run{std::move(merged), level + 1});
+    }
+  }
+
+  External_sort_options m_options;
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Shortcut for `External_sorter(options).sort(source, frame)`.
+template <class Source>
+Sorted_run_reader external_sort(Source& source, const Sweep_frame& frame,
+                                const External_sort_options& options = External_sort_options())
+{
+  return External_sorter(options).sort(source, frame);
+}
+
+} // namespace streaming
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_STREAMING_EXTERNAL_SORT_H
