@@ -592,3 +592,103 @@ TEST(Streaming_sweep, RefusesUnsortedInput)
                  src, [](const NO::streaming::Point_record& r) { return r.position[0]; }, options, visitor, window)),
                std::invalid_argument);
 }
+
+// ---------------------------------------------------------------------------
+// Streaming orientation against the in-core one.
+
+#include <Normal_orientation/streaming_orient_normals.h>
+
+namespace {
+
+struct Rewindable_source
+{
+  std::vector<NO::streaming::Point_record> records;
+  std::size_t next = 0;
+  std::size_t read(std::vector<NO::streaming::Point_record>& chunk, std::size_t maximum)
+  {
+    const std::size_t m = std::min(maximum, records.size() - next);
+    chunk.insert(chunk.end(), records.begin() + std::ptrdiff_t(next), records.begin() + std::ptrdiff_t(next + m));
+    next += m;
+    return m;
+  }
+  void rewind() { next = 0; }
+};
+
+std::vector<NO::streaming::Point_record> as_records(const std::vector<PN>& cloud)
+{
+  std::vector<NO::streaming::Point_record> r;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    r.push_back({{cloud[i].first.x(), cloud[i].first.y(), cloud[i].first.z()},
+                 {cloud[i].second.x(), cloud[i].second.y(), cloud[i].second.z()},
+                 i});
+  return r;
+}
+
+} // namespace
+
+TEST(Streaming_orient_normals, AgreesWithInCoreAndFacesOutward)
+{
+  std::mt19937_64 rng(31);
+  struct Case
+  {
+    const char* name;
+    std::vector<Sample> truth;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"sphere", sphere(20000, rng)});
+  cases.push_back({"torus", torus(30000, rng)});
+  {
+    auto two = sphere(10000, rng);
+    const auto b = sphere(10000, rng, Point(3, 0.5, 0), 0.7);
+    two.insert(two.end(), b.begin(), b.end());
+    cases.push_back({"two spheres", two});
+  }
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const auto input = unoriented(c.truth, rng, 0.1);
+    auto in_core = input;
+    const NO::Orientation_result ic = NO::orient_normals(in_core, pn_params());
+    Rewindable_source src{as_records(input)};
+    std::vector<NO::streaming::Point_record> out;
+    auto sink = [&](const NO::streaming::Point_record& r) { out.push_back(r); };
+    NO::Streaming_options options;
+    options.radius = ic.neighbor_radius; // the same graph as in core
+    options.batch_size = 2000;
+    options.sort.memory_budget = 200000 * sizeof(NO::streaming::Point_record) / 50; // several runs
+    const NO::Streaming_result sr = NO::streaming_orient_normals(src, sink, options);
+    ASSERT_EQ(out.size(), input.size());
+    EXPECT_EQ(sr.number_of_points, input.size());
+    EXPECT_EQ(sr.number_of_edges, ic.number_of_edges);
+    EXPECT_EQ(sr.number_of_components, ic.number_of_components);
+    EXPECT_LT(sr.number_of_segments, input.size() / 20);
+    EXPECT_LT(sr.peak_window, input.size());
+    std::vector<char> seen(input.size(), 0);
+    std::size_t wrong = 0, differ = 0;
+    for (const auto& r : out) {
+      ASSERT_LT(r.index, input.size());
+      ASSERT_FALSE(seen[r.index]);
+      seen[r.index] = 1;
+      const Vector n(r.normal[0], r.normal[1], r.normal[2]);
+      EXPECT_TRUE(n == input[r.index].second || n == -input[r.index].second); // only the sign changes
+      wrong += (n * c.truth[r.index].n <= 0.0) ? 1 : 0;
+      differ += (n != in_core[r.index].second) ? 1 : 0;
+    }
+    EXPECT_EQ(wrong, count_wrong(c.truth, in_core)) << "streamed wrong normals";
+    EXPECT_LE(differ, input.size() / 200); // at most 0.5% of the points differ
+    std::cout << "[ info ] streaming " << c.name << ": " << sr.number_of_segments << " segments, peak window "
+              << sr.peak_window << ", " << wrong << " wrong, " << differ << " differ from in core\n";
+
+    // the estimated radius is close to the in-core one
+    Rewindable_source again{as_records(input)};
+    std::vector<NO::streaming::Point_record> out2;
+    auto sink2 = [&](const NO::streaming::Point_record& r) { out2.push_back(r); };
+    NO::Streaming_options estimated;
+    const NO::Streaming_result er = NO::streaming_orient_normals(again, sink2, estimated);
+    EXPECT_TRUE(er.radius_estimated);
+    EXPECT_NEAR(er.neighbor_radius / ic.neighbor_radius, 1.0, 0.25);
+    std::size_t wrong2 = 0;
+    for (const auto& r : out2)
+      wrong2 += (Vector(r.normal[0], r.normal[1], r.normal[2]) * c.truth[r.index].n <= 0.0) ? 1 : 0;
+    EXPECT_LE(wrong2, input.size() / 200);
+  }
+}
