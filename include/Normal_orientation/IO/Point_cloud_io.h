@@ -867,19 +867,25 @@ inline void store_vertex_value(Point_cloud& cloud, std::size_t vertex, std::size
   else cloud.extra_values[vertex * cloud.extra_properties.size() + (role - 6)] = value;
 }
 
+/// \brief Checks that the coordinates `point[0..2]` and, unless `normal` is null, the
+/// normal `normal[0..2]` are finite; the error message names the point as `<where>
+/// <position>`, e.g. `line 12` or `vertex 11`.
+inline void check_finite_values(const std::string& filename, const double* point, const double* normal,
+                                const char* where, std::uint64_t position)
+{
+  if(!(std::isfinite(point[0]) && std::isfinite(point[1]) && std::isfinite(point[2])))
+    fail(filename, std::string("non-finite coordinate at ") + where + " " + std::to_string(position));
+  if(normal != nullptr && !(std::isfinite(normal[0]) && std::isfinite(normal[1]) && std::isfinite(normal[2])))
+    fail(filename, std::string("non-finite normal at ") + where + " " + std::to_string(position));
+}
+
 /// \brief Checks that point `vertex` has finite coordinates and normal; the error
 /// message names it as `<where> <position>`, e.g. `line 12` or `vertex 11`.
 inline void check_finite_vertex(const std::string& filename, const Point_cloud& cloud,
                                 std::size_t vertex, const char* where, std::size_t position)
 {
-  const std::array<double, 3>& p = cloud.points[vertex];
-  if(!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2])))
-    fail(filename, std::string("non-finite coordinate at ") + where + " " + std::to_string(position));
-  if(cloud.has_normals()) {
-    const std::array<double, 3>& n = cloud.normals[vertex];
-    if(!(std::isfinite(n[0]) && std::isfinite(n[1]) && std::isfinite(n[2])))
-      fail(filename, std::string("non-finite normal at ") + where + " " + std::to_string(position));
-  }
+  check_finite_values(filename, cloud.points[vertex].data(),
+                      cloud.has_normals() ? cloud.normals[vertex].data() : nullptr, where, position);
 }
 
 /// \brief Skips the binary data of `element` starting at `p`; returns the end of the data.
@@ -972,6 +978,34 @@ struct Line_reader
   }
 };
 
+/// \brief Parses the row `[q, eol)`, line `line` of the file, of the ASCII PLY element
+/// `element`, which must have scalar properties only, into `values` (one per property).
+inline void parse_ascii_row(const std::string& filename, const Ply_header_element& element, const char* q,
+                            const char* eol, std::uint64_t line, double* values)
+{
+  const std::size_t property_count = element.properties.size();
+  auto at_line = [line] { return " at line " + std::to_string(line); };
+  for(std::size_t j = 0; j < property_count; ++j) {
+    while(q != eol && is_blank(*q)) ++q;
+    if(q == eol)
+      fail(filename, "short line: " + std::to_string(j) + " values instead of " +
+                       std::to_string(property_count) + at_line());
+    const char* token_end = q;
+    while(token_end != eol && !is_blank(*token_end)) ++token_end;
+    const Ply_header_property& property = element.properties[j];
+    const Parse_status status = parse_ply_ascii_value(q, token_end, property.type, values[j]);
+    if(status == Parse_status::INVALID)
+      fail(filename, "non-numeric token " + quoted(q, token_end) + at_line());
+    if(status == Parse_status::OUT_OF_RANGE)
+      fail(filename, "value " + quoted(q, token_end) + " out of range for property '" + property.name +
+                       "' of type " + ply_scalar_type_name(property.type) + at_line());
+    q = token_end;
+  }
+  while(q != eol && is_blank(*q)) ++q;
+  if(q != eol)
+    fail(filename, "too many values: expected " + std::to_string(property_count) + at_line());
+}
+
 /// \brief Decodes the ASCII vertex data, one vertex per line.
 inline void read_ascii_vertices(const std::string& filename, const Ply_header_element& element,
                                 const std::vector<std::size_t>& roles, Line_reader& reader,
@@ -987,6 +1021,7 @@ inline void read_ascii_vertices(const std::string& filename, const Ply_header_el
   if(has_normals) cloud.normals.reserve(reserved);
   cloud.extra_values.reserve(reserved * extra_count);
 
+  std::vector<double> row(property_count);
   for(std::size_t i = 0; i < element.count; ++i) {
     const char* q = nullptr;
     const char* eol = nullptr;
@@ -994,28 +1029,8 @@ inline void read_ascii_vertices(const std::string& filename, const Ply_header_el
     cloud.points.emplace_back();
     if(has_normals) cloud.normals.emplace_back();
     cloud.extra_values.resize(cloud.extra_values.size() + extra_count);
-    const std::string at_line = " at line " + std::to_string(reader.line);
-    for(std::size_t j = 0; j < property_count; ++j) {
-      while(q != eol && is_blank(*q)) ++q;
-      if(q == eol)
-        fail(filename, "short line: " + std::to_string(j) + " values instead of " +
-                         std::to_string(property_count) + at_line);
-      const char* token_end = q;
-      while(token_end != eol && !is_blank(*token_end)) ++token_end;
-      double value = 0;
-      const Ply_header_property& property = element.properties[j];
-      const Parse_status status = parse_ply_ascii_value(q, token_end, property.type, value);
-      if(status == Parse_status::INVALID)
-        fail(filename, "non-numeric token " + quoted(q, token_end) + at_line);
-      if(status == Parse_status::OUT_OF_RANGE)
-        fail(filename, "value " + quoted(q, token_end) + " out of range for property '" + property.name +
-                         "' of type " + ply_scalar_type_name(property.type) + at_line);
-      store_vertex_value(cloud, i, roles[j], value);
-      q = token_end;
-    }
-    while(q != eol && is_blank(*q)) ++q;
-    if(q != eol)
-      fail(filename, "too many values: expected " + std::to_string(property_count) + at_line);
+    parse_ascii_row(filename, element, q, eol, reader.line, row.data());
+    for(std::size_t j = 0; j < property_count; ++j) store_vertex_value(cloud, i, roles[j], row[j]);
     check_finite_vertex(filename, cloud, i, "line", reader.line);
   }
 }
@@ -1099,6 +1114,19 @@ public:
   {
     char* first = room(max_number_length);
     used_ += static_cast<std::size_t>(format_real(first, value, precision) - first);
+  }
+
+  /// Replaces the `data.size()` bytes at byte `offset` of the data put so far (for
+  /// instance a count in a header, written with a fixed width); appending resumes at
+  /// the end of the data.
+  void overwrite(std::uint64_t offset, std::string_view data)
+  {
+    flush_buffer();
+    if(::fseeko(file_, static_cast<off_t>(offset), SEEK_SET) != 0)
+      fail(target_, "cannot seek in file: " + error_text(errno));
+    write_through(data.data(), data.size());
+    if(::fseeko(file_, 0, SEEK_END) != 0)
+      fail(target_, "cannot seek in file: " + error_text(errno));
   }
 
   /// Writes the remaining data, closes the temporary file and renames it over the target.
@@ -1278,6 +1306,47 @@ struct Xyz_chunk
   std::string error_token;      // NON_NUMERIC, OUT_OF_RANGE: the token, quoted
 };
 
+/// \brief Parses the values of the line `[q, eol)` (without its `'\n'`) of a
+/// `.xyz`/`.pwn` text, as `read_xyz()` specifies: stores the first six values in
+/// `values` and sets `n` to the number of values of the line (which may exceed 6; 0 for
+/// a blank or comment line), and raises `digits[0]` (coordinates) and `digits[1]`
+/// (normals) to the significant digits of the values (see `Point_cloud::point_digits`).
+/// Returns `Xyz_error::NONE`, or `NON_NUMERIC` or `OUT_OF_RANGE` with the offending
+/// token, quoted, in `error_token`. Non-finite values are not rejected here.
+inline Xyz_error parse_xyz_values(const char* q, const char* const eol, std::array<double, 6>& values,
+                                  std::size_t& n, int (&digits)[2], std::string& error_token)
+{
+  n = 0;
+  for(;;) {
+    while(q != eol && is_blank(*q)) ++q;
+    if(q == eol || (n == 0 && *q == '#')) return Xyz_error::NONE;
+    if(n < 6) {
+      // Parse in place: the number must be followed by a blank or the end of the line.
+      const char* first = (*q == '+' && q + 1 != eol && q[1] != '-' && q[1] != '+') ? q + 1 : q;
+      const std::from_chars_result result = std::from_chars(first, eol, values[n]);
+      if(result.ec == std::errc() && (result.ptr == eol || is_blank(*result.ptr))) {
+        // Count the digits only if the token may have more than `maximum`: it has at
+        // most as many as characters, its sign and a leading `0.` excluded.
+        int& maximum = digits[n < 3 ? 0 : 1];
+        const char* const unsigned_first = first + (*first == '-');
+        std::ptrdiff_t bound = result.ptr - unsigned_first;
+        if(bound >= 2 && unsigned_first[0] == '0' && unsigned_first[1] == '.') bound -= 2;
+        if(bound > maximum || maximum == 0) maximum = std::max(maximum, significant_digits(first, result.ptr));
+        q = result.ptr;
+        ++n;
+        continue;
+      }
+      const char* token_end = q;
+      while(token_end != eol && !is_blank(*token_end)) ++token_end;
+      error_token = quoted(q, token_end);
+      const bool out_of_range = result.ec == std::errc::result_out_of_range && result.ptr == token_end;
+      return out_of_range ? Xyz_error::OUT_OF_RANGE : Xyz_error::NON_NUMERIC;
+    }
+    while(q != eol && !is_blank(*q)) ++q;
+    ++n;
+  }
+}
+
 /// \brief Parses the whole lines `[p, end)` of a `.xyz`/`.pwn` text into `chunk`, as
 /// `read_xyz()` specifies, up to the first error, which is recorded in `chunk`.
 inline void parse_xyz_chunk(const char* p, const char* const end, Xyz_chunk& chunk)
@@ -1295,36 +1364,10 @@ inline void parse_xyz_chunk(const char* p, const char* const end, Xyz_chunk& chu
     const char* const eol = end_of_line(p, end);
     std::array<double, 6> values{};
     std::size_t n = 0;
-    const char* q = p;
+    const char* const q = p;
     p = (eol < end) ? eol + 1 : end;
-    for(;;) {
-      while(q != eol && is_blank(*q)) ++q;
-      if(q == eol || (n == 0 && *q == '#')) break;
-      if(n < 6) {
-        // Parse in place: the number must be followed by a blank or the end of the line.
-        const char* first = (*q == '+' && q + 1 != eol && q[1] != '-' && q[1] != '+') ? q + 1 : q;
-        const std::from_chars_result result = std::from_chars(first, eol, values[n]);
-        if(result.ec == std::errc() && (result.ptr == eol || is_blank(*result.ptr))) {
-          // Count the digits only if the token may have more than `maximum`: it has at
-          // most as many as characters, its sign and a leading `0.` excluded.
-          int& maximum = digits[n < 3 ? 0 : 1];
-          const char* const unsigned_first = first + (*first == '-');
-          std::ptrdiff_t bound = result.ptr - unsigned_first;
-          if(bound >= 2 && unsigned_first[0] == '0' && unsigned_first[1] == '.') bound -= 2;
-          if(bound > maximum || maximum == 0) maximum = std::max(maximum, significant_digits(first, result.ptr));
-          q = result.ptr;
-          ++n;
-          continue;
-        }
-        const char* token_end = q;
-        while(token_end != eol && !is_blank(*token_end)) ++token_end;
-        chunk.error_token = quoted(q, token_end);
-        const bool out_of_range = result.ec == std::errc::result_out_of_range && result.ptr == token_end;
-        return failed(out_of_range ? Xyz_error::OUT_OF_RANGE : Xyz_error::NON_NUMERIC);
-      }
-      while(q != eol && !is_blank(*q)) ++q;
-      ++n;
-    }
+    const Xyz_error error = parse_xyz_values(q, eol, values, n, digits, chunk.error_token);
+    if(error != Xyz_error::NONE) return failed(error);
     if(n == 0) continue; // blank or comment line
     if(n != 3 && n != 6) {
       chunk.error_values = n;
@@ -1353,6 +1396,32 @@ inline void parse_xyz_chunk(const char* p, const char* const end, Xyz_chunk& chu
   chunk.normal_digits = digits[1];
 }
 
+/// \brief Message (without the file name) of the error `error` (not `NONE`) of a
+/// `.xyz`/`.pwn` text at line `line`: `values` is the number of values of the line
+/// (`COLUMN_COUNT`, `COLUMN_MISMATCH`), `token` the quoted token (`NON_NUMERIC`,
+/// `OUT_OF_RANGE`), `first_data_line` and `columns` the line number and number of values
+/// of the first data line of the file (`COLUMN_MISMATCH`).
+inline std::string xyz_error_message(Xyz_error error, std::size_t line, std::size_t values,
+                                     const std::string& token, std::size_t first_data_line,
+                                     std::size_t columns)
+{
+  const std::string at_line = " at line " + std::to_string(line);
+  switch(error) {
+  case Xyz_error::NONE: break;
+  case Xyz_error::NON_NUMERIC: return "non-numeric token " + token + at_line;
+  case Xyz_error::OUT_OF_RANGE: return "number " + token + " out of range" + at_line;
+  case Xyz_error::COLUMN_COUNT:
+    return "wrong column count" + at_line + ": " + std::to_string(values) +
+           " values, expected 3 (x y z) or 6 (x y z nx ny nz)";
+  case Xyz_error::COLUMN_MISMATCH:
+    return "wrong column count" + at_line + ": " + std::to_string(values) + " values, but line " +
+           std::to_string(first_data_line) + " has " + std::to_string(columns);
+  case Xyz_error::NON_FINITE_COORDINATE: return "non-finite coordinate" + at_line;
+  case Xyz_error::NON_FINITE_NORMAL: return "non-finite normal" + at_line;
+  }
+  return "error" + at_line;
+}
+
 /// \brief The cloud made of the consecutive `chunks` of the text file `filename`, or
 /// the first error in file order, with line numbers counted from the start of the file.
 /// The chunks are consumed.
@@ -1361,10 +1430,6 @@ inline Point_cloud merge_xyz_chunks(const std::string& filename, std::vector<Xyz
   std::size_t columns = 0;
   std::size_t first_data_line = 0;
   std::size_t lines_before = 0; // lines of the previous chunks
-  auto wrong_columns = [&](std::size_t line, std::size_t values) {
-    return "wrong column count at line " + std::to_string(line) + ": " + std::to_string(values) +
-           " values, but line " + std::to_string(first_data_line) + " has " + std::to_string(columns);
-  };
   Point_cloud cloud;
   std::size_t point_count = 0;
   for(const Xyz_chunk& chunk : chunks) {
@@ -1374,22 +1439,13 @@ inline Point_cloud merge_xyz_chunks(const std::string& filename, std::vector<Xyz
         columns = chunk.columns;
         first_data_line = lines_before + chunk.first_data_line;
       } else if(chunk.columns != columns) {
-        fail(filename, wrong_columns(lines_before + chunk.first_data_line, chunk.columns));
+        fail(filename, xyz_error_message(Xyz_error::COLUMN_MISMATCH, lines_before + chunk.first_data_line,
+                                         chunk.columns, std::string(), first_data_line, columns));
       }
     }
-    const std::string at_line = " at line " + std::to_string(lines_before + chunk.error_line);
-    switch(chunk.error) {
-    case Xyz_error::NONE: break;
-    case Xyz_error::NON_NUMERIC: fail(filename, "non-numeric token " + chunk.error_token + at_line);
-    case Xyz_error::OUT_OF_RANGE: fail(filename, "number " + chunk.error_token + " out of range" + at_line);
-    case Xyz_error::COLUMN_COUNT:
-      fail(filename, "wrong column count" + at_line + ": " + std::to_string(chunk.error_values) +
-                       " values, expected 3 (x y z) or 6 (x y z nx ny nz)");
-    case Xyz_error::COLUMN_MISMATCH:
-      fail(filename, wrong_columns(lines_before + chunk.error_line, chunk.error_values));
-    case Xyz_error::NON_FINITE_COORDINATE: fail(filename, "non-finite coordinate" + at_line);
-    case Xyz_error::NON_FINITE_NORMAL: fail(filename, "non-finite normal" + at_line);
-    }
+    if(chunk.error != Xyz_error::NONE)
+      fail(filename, xyz_error_message(chunk.error, lines_before + chunk.error_line, chunk.error_values,
+                                       chunk.error_token, first_data_line, columns));
     lines_before += chunk.lines;
     point_count += chunk.points.size();
     cloud.point_digits = std::max(cloud.point_digits, chunk.point_digits);
