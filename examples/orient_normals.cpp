@@ -12,6 +12,7 @@
 #include <Normal_orientation/orient_normals.h>
 #include <Normal_orientation/solvers/Lsa_tr_solver.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
+#include <Normal_orientation/streaming_orient_normals.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/jet_estimate_normals.h>
@@ -95,6 +96,8 @@ struct Options
   int threads = 0;
   unsigned long seed = 0;
   bool json = false, quiet = false, ascii = false;
+  bool stream = false;
+  bool sign_given = false;
 };
 
 const char* usage_text =
@@ -122,6 +125,10 @@ const char* usage_text =
   "  --normal-k N         neighbours of the normal estimator (default 18)\n"
   "  --threads N          threads (default: all cores); results do not depend on it\n"
   "  --seed S             random seed of randomised solvers (default 0)\n"
+  "  --stream             out of core, for clouds larger than memory: sort along the\n"
+  "                       principal axis (temporary files in TMPDIR), sweep, segment,\n"
+  "                       solve the segment graph; IN must have normals; OUT holds\n"
+  "                       the points in sweep order (outward sign only)\n"
   "  --ascii              write PLY as ascii instead of binary\n"
   "  --json               print one JSON object with the report on stdout\n"
   "  --quiet              print nothing on stderr but errors\n"
@@ -175,6 +182,7 @@ Options parse_options(int argc, char** argv)
       o.orders = unsigned(n);
     } else if (a == "--sign") {
       o.sign = value();
+      o.sign_given = true;
       if (o.sign != "outward" && o.sign != "keep")
         throw Usage_error("unknown sign policy '" + o.sign + "' (outward, keep)");
     } else if (a == "--viewpoint") {
@@ -213,6 +221,8 @@ Options parse_options(int argc, char** argv)
       o.quiet = true;
     } else if (a == "--ascii") {
       o.ascii = true;
+    } else if (a == "--stream") {
+      o.stream = true;
     } else if (a.size() > 1 && a[0] == '-') {
       throw Usage_error("unknown option " + a);
     } else {
@@ -223,6 +233,8 @@ Options parse_options(int argc, char** argv)
     throw Usage_error("too many arguments");
   if (o.prior_weight > 0.0 && !o.has_viewpoint)
     throw Usage_error("--prior-weight needs --viewpoint");
+  if (o.stream && (o.has_viewpoint || (o.sign_given && o.sign != "outward")))
+    throw Usage_error("--stream orients every component outward: --sign keep and --viewpoint are not supported");
   if (positional.empty()) {
     o.input = NORMAL_ORIENTATION_SAMPLE_CLOUD;
     o.output = "sample_oriented.ply";
@@ -328,10 +340,64 @@ NO::Orientation_result run_with_criterion(Range& range, const Np& np, const Opti
   return with_sign(NO::Hoppe_criterion());
 }
 
+/// --stream: the out-of-core pipeline, file to file.
+int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
+{
+  NO::Streaming_options so;
+  so.number_of_neighbors = o.k;
+  so.radius = o.radius;
+  NO::IO::Point_stream_write_options wo;
+  wo.binary = !o.ascii;
+  NO::Streaming_result r;
+  auto with_solver = [&](const auto& criterion) {
+    if (o.solver == "mst")
+      return NO::streaming_orient_files(o.input, o.output, so, criterion, NO::Mst_solver(), wo);
+    if (o.solver == "lsa-tr")
+      return NO::streaming_orient_files(o.input, o.output, so, criterion, NO::Lsa_tr_solver(), wo);
+    return NO::streaming_orient_files(o.input, o.output, so, criterion, NO::Qpbo_i_solver(o.orders, o.seed), wo);
+  };
+  NO::internal::run_with_threads(o.threads, [&]() {
+    if (o.criterion == "xie")
+      r = with_solver(NO::Xie_criterion());
+    else if (o.criterion == "konig")
+      r = with_solver(NO::Konig_criterion());
+    else
+      r = with_solver(NO::Hoppe_criterion());
+  });
+  const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!o.quiet) {
+    std::fprintf(stderr,
+                 "oriented %llu points out of core: %llu edges (k = %u, r = %.6g), %zu segments, %zu component%s, "
+                 "peak window %zu points, %llu normals flipped, %.3f s\n",
+                 (unsigned long long)r.number_of_points, (unsigned long long)r.number_of_edges, o.k, r.neighbor_radius,
+                 r.number_of_segments, r.number_of_components, r.number_of_components == 1 ? "" : "s", r.peak_window,
+                 (unsigned long long)r.number_of_flipped, total);
+    std::error_code ec;
+    const std::string where = std::filesystem::absolute(o.output, ec).string();
+    std::fprintf(stderr, "wrote %s\n", ec ? o.output.c_str() : where.c_str());
+  }
+  if (o.json)
+    std::printf("{\"input\": \"%s\", \"output\": \"%s\", \"mode\": \"stream\", \"points\": %llu, \"edges\": %llu, "
+                "\"segments\": %zu, \"segment_edges\": %zu, \"components\": %zu, \"peak_window\": %zu, \"k\": %u, "
+                "\"radius\": %.9g, \"radius_estimated\": %s, \"criterion\": \"%s\", \"solver\": \"%s\", "
+                "\"threads\": %d, \"energy_before\": %.9g, \"energy_after\": %.9g, \"flipped\": %llu, "
+                "\"seconds\": {\"frame\": %.6f, \"radius\": %.6f, \"sort\": %.6f, \"sweep\": %.6f, \"solve\": %.6f, "
+                "\"sign\": %.6f, \"output\": %.6f, \"total\": %.6f}}\n",
+                json_escape(o.input).c_str(), json_escape(o.output).c_str(), (unsigned long long)r.number_of_points,
+                (unsigned long long)r.number_of_edges, r.number_of_segments, r.number_of_segment_edges,
+                r.number_of_components, r.peak_window, o.k, r.neighbor_radius, r.radius_estimated ? "true" : "false",
+                o.criterion.c_str(), o.solver.c_str(), o.threads, r.segment_energy_before, r.segment_energy_after,
+                (unsigned long long)r.number_of_flipped, r.seconds.frame, r.seconds.radius, r.seconds.sort,
+                r.seconds.sweep, r.seconds.solve, r.seconds.sign, r.seconds.output, total);
+  return 0;
+}
+
 int main_impl(int argc, char** argv)
 {
   const auto t0 = std::chrono::steady_clock::now();
   const Options o = parse_options(argc, argv);
+  if (o.stream)
+    return run_stream(o, t0);
   auto since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   };

@@ -8,6 +8,8 @@ set -u
 prog=$(realpath "$1")
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
+mkdir -p "$dir/tmp"
+export TMPDIR="$dir/tmp"
 fails=0
 passes=0
 check() { # description, then a command that must succeed
@@ -64,6 +66,27 @@ for solver in mst qpbo-i lsa-tr; do
   check "prior normals point inward ($solver)" awk '{ if ($1*$4 + $2*$5 + $3*$6 >= 0) bad++ } END { exit bad > 0 }' \
     "$dir/prior_$solver.xyz"
 done
+
+# --stream: out of core; every normal outward, each input point exactly once
+# (in sweep order), only signs changed; the same with 1 and 2 threads
+expect_exit 0 "stream" "$prog" --quiet --json --stream "$dir/sphere.xyz" "$dir/stream.xyz"
+check "stream json" grep -q '"mode": "stream"' "$dir/out.txt"
+check "stream json has segments" grep -q '"segments": ' "$dir/out.txt"
+check "stream output is a permutation of the input with outward normals" awk '
+  NR==FNR { key[sprintf("%.7f %.7f %.7f", $1, $2, $3)] = $4 " " $5 " " $6; n++; next }
+  { k = sprintf("%.7f %.7f %.7f", $1, $2, $3); if (!(k in key) || seen[k]++ || $1*$4 + $2*$5 + $3*$6 <= 0) bad++;
+    split(key[k], m, " ");
+    if (($4 != m[1]+0 || $5 != m[2]+0 || $6 != m[3]+0) && ($4 != -m[1] || $5 != -m[2] || $6 != -m[3])) bad++; c++ }
+  END { exit (bad > 0 || c != n) }' "$dir/sphere.xyz" "$dir/stream.xyz"
+expect_exit 0 "stream to binary ply, 1 thread" "$prog" --quiet --stream --threads 1 "$dir/sphere.xyz" "$dir/s1.ply"
+expect_exit 0 "stream to binary ply, 2 threads" "$prog" --quiet --stream --threads 2 "$dir/sphere.xyz" "$dir/s2.ply"
+check "stream: same bytes with 1 and 2 threads" cmp -s "$dir/s1.ply" "$dir/s2.ply"
+expect_exit 0 "stream reads its own ply" "$prog" --quiet --stream --solver mst "$dir/s1.ply" "$dir/s3.xyz"
+awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/nonormals.xyz"
+expect_exit 1 "stream needs normals" "$prog" --quiet --stream "$dir/nonormals.xyz" "$dir/none.xyz"
+check "no output after a failed stream" test ! -e "$dir/none.xyz"
+expect_exit 2 "stream refuses --viewpoint" "$prog" --quiet --stream --viewpoint 0,0,0 "$dir/sphere.xyz" "$dir/none.xyz"
+check "no temporary files left in TMPDIR" test -z "$(ls -A "$dir/tmp" 2>/dev/null)"
 
 # points without normals: estimated first
 awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/bare.xyz"

@@ -12,6 +12,7 @@
 #include <Normal_orientation/Component_sign.h>
 #include <Normal_orientation/Flip_criteria.h>
 #include <Normal_orientation/Neighbor_graph.h>
+#include <Normal_orientation/IO/Point_stream.h>
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
 #include <Normal_orientation/streaming/Point_record.h>
@@ -416,6 +417,40 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   }
   result.seconds.output = since(t);
   result.seconds.total = since(t_start);
+  return result;
+}
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Orients the cloud of the file `input` (.xyz/.pwn with normals, or .ply,
+/// read in chunks by `IO::Point_stream_reader`) out of core with
+/// `streaming_orient_normals()` and writes it to `output` (.xyz, .pwn or
+/// .ply by extension; binary PLY unless `write_options.binary` is false).
+/// The output holds the points in the sweep order (along the principal
+/// axis), with their input coordinates and normals whose sign only may
+/// have changed.  It is written to a temporary file renamed at the end: on
+/// any error no output file exists.
+/// \throw IO::Io_error for unreadable, malformed or unwritable files, or an
+///        input without normals; see `streaming_orient_normals()`
+template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag,
+          typename Kernel = CGAL::Exact_predicates_inexact_constructions_kernel,
+          typename FlipCriterion = Hoppe_criterion, typename Solver = Qpbo_i_solver>
+Streaming_result streaming_orient_files(const std::string& input, const std::string& output,
+                                        const Streaming_options& options = Streaming_options(),
+                                        const FlipCriterion& criterion = FlipCriterion(),
+                                        const Solver& solver = Solver(),
+                                        const IO::Point_stream_write_options& write_options =
+                                          IO::Point_stream_write_options())
+{
+  IO::Point_stream_reader reader(input);
+  if (!reader.has_normals())
+    throw IO::Io_error(input + ": the file has no normals (streaming needs them)");
+  IO::Point_stream_writer writer(output, write_options);
+  auto sink = [&writer](const streaming::Point_record& r) { writer.write(r); };
+  Streaming_result result =
+    streaming_orient_normals<ConcurrencyTag, Kernel>(reader, sink, options, criterion, solver);
+  const auto t = std::chrono::steady_clock::now();
+  writer.commit();
+  result.seconds.output += std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   return result;
 }
 
