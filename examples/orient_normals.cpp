@@ -21,6 +21,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -507,8 +508,19 @@ int main_impl(int argc, char** argv)
 
 } // namespace
 
+/// SIGINT/SIGTERM: remove every temporary file (sort runs, record files, the
+/// output being written), then die of the signal as usual.
+extern "C" void on_terminating_signal(int sig)
+{
+  NO::remove_temporary_files();
+  std::signal(sig, SIG_DFL);
+  std::raise(sig);
+}
+
 int main(int argc, char** argv)
 {
+  std::signal(SIGINT, on_terminating_signal);
+  std::signal(SIGTERM, on_terminating_signal);
   try {
     return main_impl(argc, argv);
   } catch (const Usage_error& e) {

@@ -88,6 +88,21 @@ check "no output after a failed stream" test ! -e "$dir/none.xyz"
 expect_exit 2 "stream refuses --viewpoint" "$prog" --quiet --stream --viewpoint 0,0,0 "$dir/sphere.xyz" "$dir/none.xyz"
 check "no temporary files left in TMPDIR" test -z "$(ls -A "$dir/tmp" 2>/dev/null)"
 
+# SIGTERM during a streamed run: no output, no temporary file left
+awk 'BEGIN { srand(5); for (i = 0; i < 400000; i++) { z = 2*rand()-1; a = 6.2831853*rand(); r = sqrt(1-z*z);
+  x = r*cos(a); y = r*sin(a); s = (rand() < 0.5) ? -1 : 1; printf "%.7f %.7f %.7f %.7f %.7f %.7f\n", x, y, z, s*x, s*y, s*z } }' > "$dir/big.xyz"
+"$prog" --quiet --stream "$dir/big.xyz" "$dir/big_out.ply" 2> /dev/null &
+pid=$!
+sleep 0.5
+kill -TERM $pid 2> /dev/null
+wait $pid
+status=$?
+check "SIGTERM ends the run (status $status)" test "$status" -ne 0 -o -e "$dir/big_out.ply"
+check "no partial output after SIGTERM" test -z "$(ls "$dir" | grep '^big_out.ply.tmp')"
+if [ ! -e "$dir/big_out.ply" ]; then
+  check "no temporary files after SIGTERM" test -z "$(ls -A "$dir/tmp")"
+fi
+
 # points without normals: estimated first
 awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/bare.xyz"
 expect_exit 0 "estimates missing normals" "$prog" --quiet --normals pca "$dir/bare.xyz" "$dir/bare_out.xyz"

@@ -57,6 +57,8 @@
 
 #include <unistd.h>
 
+#include <Normal_orientation/internal/Temporary_files.h>
+
 namespace Normal_orientation {
 namespace IO {
 
@@ -1054,6 +1056,8 @@ public:
       const int error_number = errno;
       fail(target_, "cannot create temporary file '" + temporary_ + "': " + error_text(error_number));
     }
+    // a signal handler calling remove_temporary_files() removes it too
+    slot_ = Normal_orientation::internal::register_temporary_file(temporary_);
   }
 
   Atomic_output_file(const Atomic_output_file&) = delete;
@@ -1061,6 +1065,7 @@ public:
 
   ~Atomic_output_file()
   {
+    Normal_orientation::internal::unregister_temporary_file(slot_);
     if(committed_) return;
     if(file_ != nullptr) std::fclose(file_);
     std::remove(temporary_.c_str());
@@ -1143,6 +1148,8 @@ public:
       const int error_number = errno;
       fail(target_, "cannot rename '" + temporary_ + "' to the target: " + error_text(error_number));
     }
+    Normal_orientation::internal::unregister_temporary_file(slot_);
+    slot_ = -1;
     committed_ = true;
   }
 
@@ -1170,6 +1177,7 @@ private:
   std::unique_ptr<char[]> buffer_;
   std::size_t used_ = 0;
   bool committed_ = false;
+  int slot_ = -1;
 };
 
 /// \brief Checks that `cloud` is consistent and finite before writing it to `filename`.
