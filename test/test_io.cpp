@@ -7,6 +7,8 @@
 #include <Normal_orientation/IO/Point_cloud_io.h>
 #include <Normal_orientation/IO/Point_stream.h>
 
+#include "Test_directory.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -39,39 +41,11 @@ using Normal_orientation::IO::Write_options;
 using Normal_orientation::IO::read_point_cloud;
 using Normal_orientation::IO::write_point_cloud;
 
-/// \brief A fresh temporary directory, removed with its content on destruction.
-class Temporary_directory
+/// \brief A fresh temporary directory for the running test (see Test_directory.h).
+class Temporary_directory : public Normal_orientation::test::Test_directory
 {
 public:
-  Temporary_directory()
-  {
-    static std::atomic<int> counter{0};
-    const std::string name = "normal_orientation_test_io_" + std::to_string(::getpid()) + "_" +
-                             std::to_string(counter++) + "_" +
-                             ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    path_ = fs::temp_directory_path() / name;
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~Temporary_directory()
-  {
-    std::error_code error;
-    fs::remove_all(path_, error);
-  }
-  Temporary_directory(const Temporary_directory&) = delete;
-  Temporary_directory& operator=(const Temporary_directory&) = delete;
-
-  /// Full name of file `name` in the directory.
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-  /// Names of the files in the directory, sorted.
-  std::vector<std::string> listing() const
-  {
-    std::vector<std::string> names;
-    for(const fs::directory_entry& entry : fs::directory_iterator(path_))
-      names.push_back(entry.path().filename().string());
-    std::sort(names.begin(), names.end());
-    return names;
-  }
+  Temporary_directory() : Test_directory("normal_orientation_test_io_") {}
   /// Returns `true` if a temporary file (`*.tmp.*`) is in the directory.
   bool has_temporary_file() const
   {
@@ -79,9 +53,6 @@ public:
       if(name.find(".tmp.") != std::string::npos) return true;
     return false;
   }
-
-private:
-  fs::path path_;
 };
 
 /// \brief Writes `content` to `filename` as is.

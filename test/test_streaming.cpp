@@ -7,6 +7,8 @@
 
 #include <Normal_orientation/streaming/external_sort.h>
 
+#include "Test_directory.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -38,41 +40,11 @@ using ns::Point_record;
 using ns::Sweep_frame;
 using Vec = std::array<double, 3>;
 
-/// \brief A fresh temporary directory, removed with its content on destruction.
-class Temporary_directory
+/// \brief A fresh temporary directory for the running test (see Test_directory.h).
+class Temporary_directory : public Normal_orientation::test::Test_directory
 {
 public:
-  Temporary_directory()
-  {
-    static std::atomic<int> counter{0};
-    const std::string name = "normal_orientation_test_streaming_" + std::to_string(::getpid()) + "_" +
-                             std::to_string(counter++) + "_" +
-                             ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    path_ = fs::temp_directory_path() / name;
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
-  ~Temporary_directory()
-  {
-    std::error_code error;
-    fs::remove_all(path_, error);
-  }
-  Temporary_directory(const Temporary_directory&) = delete;
-  Temporary_directory& operator=(const Temporary_directory&) = delete;
-
-  /// The path of the directory.
-  std::string path() const { return path_.string(); }
-  /// The number of entries in the directory.
-  std::size_t count() const
-  {
-    std::size_t n = 0;
-    for (auto it = fs::directory_iterator(path_); it != fs::directory_iterator(); ++it)
-      ++n;
-    return n;
-  }
-
-private:
-  fs::path path_;
+  Temporary_directory() : Test_directory("normal_orientation_test_streaming_") {}
 };
 
 /// \brief An in-memory source; `on_read` (if set) is called before every read, with the

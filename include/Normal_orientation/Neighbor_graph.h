@@ -187,20 +187,33 @@ std::vector<std::uint32_t> morton_order(const std::vector<Point>& points)
 /// t = 0..k-1, sorted by distance.  Computed with CGAL's kd-tree and
 /// `Orthogonal_k_neighbor_search`, queries in parallel, in index order (so
 /// points in a spatially coherent order, see `morton_order()`, query fast).
-template <typename ConcurrencyTag, typename Kernel>
-void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, unsigned int k,
-                         std::vector<std::uint32_t>& neighbors, std::vector<float>& sq_dist,
-                         const Progress& progress, double progress_begin, double progress_end)
+/// The CGAL kd-tree over point indices (with the points cache) and its
+/// k-nearest-neighbour search, as used by the graph and the sweep.
+template <typename Kernel>
+struct Knn_tree_types
 {
   typedef typename Kernel::Point_3 Point;
   typedef CGAL::Search_traits_3<Kernel> Base_traits;
-  typedef CGAL::Pointer_property_map<Point> Pmap_factory;
-  typedef typename Pmap_factory::const_type Point_pmap;
+  typedef typename CGAL::Pointer_property_map<Point>::const_type Point_pmap;
   typedef CGAL::Search_traits_adapter<std::uint32_t, Point_pmap, Base_traits> Traits;
   typedef CGAL::Sliding_midpoint<Traits> Splitter;
   typedef CGAL::Distance_adapter<std::uint32_t, Point_pmap, CGAL::Euclidean_distance<Base_traits>> Distance;
   typedef CGAL::Kd_tree<Traits, Splitter, CGAL::Tag_true, CGAL::Tag_true> Tree;
   typedef CGAL::Orthogonal_k_neighbor_search<Traits, Distance, Splitter, Tree> Search;
+};
+
+template <typename ConcurrencyTag, typename Kernel>
+void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, unsigned int k,
+                         std::vector<std::uint32_t>& neighbors, std::vector<float>& sq_dist,
+                         const Progress& progress, double progress_begin, double progress_end)
+{
+  typedef Knn_tree_types<Kernel> Types;
+  typedef typename Types::Point_pmap Point_pmap;
+  typedef typename Types::Traits Traits;
+  typedef typename Types::Splitter Splitter;
+  typedef typename Types::Distance Distance;
+  typedef typename Types::Tree Tree;
+  typedef typename Types::Search Search;
 
   const std::size_t n = points.size();
   neighbors.assign(n * k, 0);

@@ -151,15 +151,14 @@ template <typename ConcurrencyTag, typename Kernel, typename Source, typename Ke
 Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options, Visitor& visitor,
                    Sweep_window<Payload>& window)
 {
-  typedef typename Kernel::Point_3 Point;
-  typedef CGAL::Search_traits_3<Kernel> Base_traits;
-  typedef CGAL::Pointer_property_map<Point> Pmap_factory;
-  typedef typename Pmap_factory::const_type Point_pmap;
-  typedef CGAL::Search_traits_adapter<std::uint32_t, Point_pmap, Base_traits> Traits;
-  typedef CGAL::Sliding_midpoint<Traits> Splitter;
-  typedef CGAL::Distance_adapter<std::uint32_t, Point_pmap, CGAL::Euclidean_distance<Base_traits>> Distance;
-  typedef CGAL::Kd_tree<Traits, Splitter, CGAL::Tag_true, CGAL::Tag_true> Tree;
-  typedef CGAL::Orthogonal_k_neighbor_search<Traits, Distance, Splitter, Tree> Search;
+  typedef Normal_orientation::internal::Knn_tree_types<Kernel> Types;
+  typedef typename Types::Point Point;
+  typedef typename Types::Point_pmap Point_pmap;
+  typedef typename Types::Traits Traits;
+  typedef typename Types::Splitter Splitter;
+  typedef typename Types::Distance Distance;
+  typedef typename Types::Tree Tree;
+  typedef typename Types::Search Search;
 
   const double r = options.radius;
   const unsigned int k = options.number_of_neighbors;
