@@ -200,6 +200,27 @@ struct Knn_tree_types
   typedef CGAL::Distance_adapter<std::uint32_t, Point_pmap, CGAL::Euclidean_distance<Base_traits>> Distance;
   typedef CGAL::Kd_tree<Traits, Splitter, CGAL::Tag_true, CGAL::Tag_true> Tree;
   typedef CGAL::Orthogonal_k_neighbor_search<Traits, Distance, Splitter, Tree> Search;
+
+  /// Writes to `out` / `out_d2` the k nearest neighbours of point `self`
+  /// of the tree (itself excluded; fewer when the tree has fewer points)
+  /// and their squared distances in single precision; returns how many.
+  static unsigned int nearest(const Tree& tree, const Distance& distance, const Point& query, std::uint32_t self,
+                              unsigned int k, std::uint32_t* out, float* out_d2)
+  {
+    Search search(tree, query, k + 1, 0, true, distance, true);
+    unsigned int t = 0;
+    bool self_skipped = false;
+    for (auto it = search.begin(); it != search.end() && t < k; ++it) {
+      if (!self_skipped && it->first == self) {
+        self_skipped = true;
+        continue;
+      }
+      out[t] = it->first;
+      out_d2[t] = float(CGAL::to_double(it->second));
+      ++t;
+    }
+    return t;
+  }
 };
 
 template <typename ConcurrencyTag, typename Kernel>
@@ -213,7 +234,6 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
   typedef typename Types::Splitter Splitter;
   typedef typename Types::Distance Distance;
   typedef typename Types::Tree Tree;
-  typedef typename Types::Search Search;
 
   const std::size_t n = points.size();
   neighbors.assign(n * k, 0);
@@ -234,21 +254,8 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
     parallel_chunks<ConcurrencyTag>(b1 - b0, [&](std::size_t cb, std::size_t ce) {
       for (std::size_t q = b0 + cb; q < b0 + ce; ++q) {
         const std::uint32_t i = std::uint32_t(q);
-        Search search(tree, points[i], k + 1, 0, true, distance, true);
-        std::uint32_t* out = &neighbors[std::size_t(i) * k];
-        float* out_d = &sq_dist[std::size_t(i) * k];
-        unsigned int t = 0;
-        bool self_skipped = false;
-        for (auto it = search.begin(); it != search.end() && t < k; ++it) {
-          if (!self_skipped && it->first == i) {
-            self_skipped = true;
-            continue;
-          }
-          out[t] = it->first;
-          out_d[t] = float(CGAL::to_double(it->second));
-          ++t;
-        }
         // with fewer than k + 1 points nothing is missing: k <= n - 1
+        Types::nearest(tree, distance, points[i], i, k, &neighbors[std::size_t(i) * k], &sq_dist[std::size_t(i) * k]);
       }
     }, 256);
     progress.report(progress_begin + (progress_end - progress_begin) * double(b1) / double(n));

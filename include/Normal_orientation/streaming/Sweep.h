@@ -154,11 +154,8 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
   typedef Normal_orientation::internal::Knn_tree_types<Kernel> Types;
   typedef typename Types::Point Point;
   typedef typename Types::Point_pmap Point_pmap;
-  typedef typename Types::Traits Traits;
-  typedef typename Types::Splitter Splitter;
   typedef typename Types::Distance Distance;
   typedef typename Types::Tree Tree;
-  typedef typename Types::Search Search;
 
   const double r = options.radius;
   const unsigned int k = options.number_of_neighbors;
@@ -238,7 +235,7 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
       points[s] = Point(slots[s].record.position[0], slots[s].record.position[1], slots[s].record.position[2]);
     const Point_pmap pmap = CGAL::make_property_map(static_cast<const std::vector<Point>&>(points));
     Tree tree(boost::counting_iterator<std::uint32_t>(0), boost::counting_iterator<std::uint32_t>(std::uint32_t(w)),
-              Splitter(), Traits(pmap));
+              typename Types::Splitter(), typename Types::Traits(pmap));
     tree.template build<ConcurrencyTag>();
     const Distance distance(pmap);
     const std::size_t first_slot = std::size_t(finalized - window.m_base);
@@ -248,18 +245,7 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
     Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
       for (std::size_t q = b; q < e; ++q) {
         const std::uint32_t i = std::uint32_t(first_slot + q);
-        Search search(tree, points[i], k + 1, 0, true, distance, true);
-        unsigned int t = 0;
-        bool self_skipped = false;
-        for (auto it = search.begin(); it != search.end() && t < k; ++it) {
-          if (!self_skipped && it->first == i) {
-            self_skipped = true;
-            continue;
-          }
-          knn[q * k + t] = it->first;
-          knn_d2[q * k + t] = float(CGAL::to_double(it->second));
-          ++t;
-        }
+        Types::nearest(tree, distance, points[i], i, k, &knn[q * k], &knn_d2[q * k]);
       }
     }, 256);
     report.seconds_neighbors += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
