@@ -129,8 +129,10 @@ inline std::array<double, 3> unit_normal(const streaming::Point_record& r)
 ///  3. the external sort along the axis (bounded memory, temporary files);
 ///  4. the sweep (`streaming::sweep()`): each point meets its earlier
 ///     neighbours of the k-nearest-neighbour graph, gets its edge weights
-///     w = phi * (1 - d^2 / r^2) with the neighbours' preliminary flips,
-///     and is segmented (`streaming::Segmenter`); points leaving the window
+///     w = phi * (1 - d^2 / r^2) (in parallel per batch, with the input
+///     normals; the neighbours' preliminary flips multiply them, as labels
+///     do in core) and is
+///     segmented (`streaming::Segmenter`); points leaving the window
 ///     go to a temporary record file;
 ///  5. `solver` on the segment graph (a BGL graph);
 ///  6. the outward sign of every connected component, from two passes over
@@ -240,23 +242,40 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     double r2;
     std::vector<streaming::Neighbor_vote> votes;
 
+    // The edge weights of a whole batch, in parallel, with the input
+    // normals (as in the in-core graph, in single precision); the
+    // neighbours' preliminary flips are applied in `finalize`.
+    std::vector<float> weights;
+    std::size_t cursor = 0;
+    void prepare(streaming::Sweep_window<internal::Sweep_payload>& w, std::uint64_t first,
+                 const std::vector<std::size_t>& offsets, const std::vector<streaming::Sweep_neighbor>& neighbors)
+    {
+      weights.resize(neighbors.size());
+      cursor = 0;
+      internal::parallel_chunks<ConcurrencyTag>(offsets.size() - 1, [&](std::size_t b, std::size_t e) {
+        for (std::size_t q = b; q < e; ++q) {
+          const streaming::Point_record& p = w.record(first + q);
+          const std::array<double, 3> np = internal::unit_normal(p);
+          const Point pp(p.position[0], p.position[1], p.position[2]);
+          const Vector vp(np[0], np[1], np[2]);
+          for (std::size_t t = offsets[q]; t < offsets[q + 1]; ++t) {
+            const streaming::Point_record& o = w.record(neighbors[t].sequence);
+            const std::array<double, 3> no = internal::unit_normal(o);
+            const double omega = 1.0 - double(neighbors[t].squared_distance) / r2;
+            weights[t] = float(criterion(pp, vp, Point(o.position[0], o.position[1], o.position[2]),
+                                         Vector(no[0], no[1], no[2])) *
+                               omega);
+          }
+        }
+      }, 256);
+    }
     void finalize(streaming::Sweep_window<internal::Sweep_payload>& w, std::uint64_t s,
                   const std::vector<streaming::Sweep_neighbor>& earlier)
     {
-      const streaming::Point_record& p = w.record(s);
-      const std::array<double, 3> np = internal::unit_normal(p);
-      const Point pp(p.position[0], p.position[1], p.position[2]);
-      const Vector vp(np[0], np[1], np[2]);
       votes.clear();
       for (const streaming::Sweep_neighbor& nb : earlier) {
-        const streaming::Point_record& q = w.record(nb.sequence);
         const internal::Sweep_payload& pq = w.payload(nb.sequence);
-        const std::array<double, 3> nq = internal::unit_normal(q);
-        const double omega = 1.0 - double(nb.squared_distance) / r2;
-        // the weight in single precision, as in the in-core graph
-        const float wf = float(criterion(pp, vp, Point(q.position[0], q.position[1], q.position[2]),
-                                         Vector(nq[0], nq[1], nq[2])) * omega);
-        votes.push_back({pq.segment, double(wf) * double(pq.flip)});
+        votes.push_back({pq.segment, double(weights[cursor++]) * double(pq.flip)});
       }
       const streaming::Segment_assignment a = segmenter.add_point(votes);
       w.payload(s) = internal::Sweep_payload{a.segment, a.flip};
@@ -268,7 +287,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     {
       records.append(internal::Swept_record{w.record(s), w.payload(s).segment, std::int32_t(w.payload(s).flip)});
     }
-  } visitor{criterion, segmenter, records, segment_size, r2, {}};
+  } visitor{criterion, segmenter, records, segment_size, r2, {}, {}, 0};
   streaming::Sweep_window<internal::Sweep_payload> window;
   streaming::Sweep_options so;
   so.number_of_neighbors = k;

@@ -29,6 +29,7 @@
 #include <deque>
 #include <limits>
 #include <sstream>
+#include <type_traits>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -113,6 +114,21 @@ private:
   std::uint64_t m_base = 0;
 };
 
+/// \cond SKIP_IN_MANUAL
+namespace internal {
+/// true when `Visitor` has `prepare(window, first, offsets, neighbors)`
+template <typename Visitor, typename Window, typename = void>
+struct Has_prepare : std::false_type
+{};
+template <typename Visitor, typename Window>
+struct Has_prepare<Visitor, Window,
+                   std::void_t<decltype(std::declval<Visitor&>().prepare(
+                     std::declval<Window&>(), std::uint64_t(0), std::declval<const std::vector<std::size_t>&>(),
+                     std::declval<const std::vector<Sweep_neighbor>&>()))>> : std::true_type
+{};
+} // namespace internal
+/// \endcond
+
 /// \ingroup PkgNormalOrientationStreaming
 /// Sweeps the points of `source` (a model of the streaming source concept:
 /// `std::size_t read(std::vector<Point_record>& chunk, std::size_t maximum)`
@@ -125,7 +141,11 @@ private:
 /// sequence, earlier)` is called with its neighbours of smaller sequence
 /// number in the graph of `build_neighbor_graph()` (j is a neighbour of p
 /// iff one is among the other's k nearest and |p - j| < r; `earlier` is
-/// sorted by sequence number), all of them still in `window`.  A point is
+/// sorted by sequence number), all of them still in `window`.  Points are
+/// finalised in batches; a visitor with a member `prepare(window, first,
+/// offsets, neighbors)` gets the whole batch first (point first + q has the
+/// neighbours `neighbors[offsets[q]] ... neighbors[offsets[q+1]-1]`), for
+/// work that can run in parallel, such as edge weights.  A point is
 /// released (`visitor.release(window, sequence)`, in order) once no point
 /// that may still need it remains to be finalised; then it leaves the
 /// window.  The window holds at most the points of a slab of thickness 3r
@@ -181,7 +201,10 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
     std::uint64_t target, source;
     float squared_distance;
   };
-  std::vector<Reverse> reverse;
+  std::vector<Reverse> reverse, bucketed;
+  std::vector<std::size_t> batch_first;
+  std::vector<Sweep_neighbor> batch_neighbors;
+  std::vector<std::size_t> bucket_start;
   std::vector<Point> points;
   std::vector<std::uint32_t> knn;
   std::vector<float> knn_d2;
@@ -261,36 +284,60 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
         if (sj > sp)
           reverse.push_back({sj, sp, knn_d2[q * k + t]});
       }
-    std::sort(reverse.begin(), reverse.end(), [](const Reverse& a, const Reverse& b) {
-      return a.target != b.target ? a.target < b.target : a.source < b.source;
-    });
+    // Bucket them by target (a stable counting sort over the targets still
+    // in the window, all at or after `finalized`); the order within a
+    // target does not matter, the lists are sorted per point below.
+    {
+      const std::size_t span = std::size_t(window.m_base + slots.size() - finalized);
+      bucket_start.assign(span + 1, 0);
+      for (const Reverse& e : reverse)
+        ++bucket_start[std::size_t(e.target - finalized) + 1];
+      for (std::size_t b = 0; b < span; ++b)
+        bucket_start[b + 1] += bucket_start[b];
+      bucketed.resize(reverse.size());
+      for (const Reverse& e : reverse)
+        bucketed[bucket_start[std::size_t(e.target - finalized)]++] = e;
+      reverse.swap(bucketed);
+    }
 
-    // 4. Finalise in order.
+    // 4. The earlier neighbours of every point of the batch (sorted by
+    //    sequence number), then the visitor: `prepare` on the whole batch
+    //    when it has one (it may work in parallel), then `finalize` in order.
     std::size_t rv = 0;
+    batch_first.assign(1, 0);
+    batch_neighbors.clear();
     for (std::size_t q = 0; q < count; ++q) {
       const std::uint64_t sp = finalized + q;
-      earlier.clear();
+      const std::size_t begin = batch_neighbors.size();
       for (unsigned int t = 0; t < k; ++t) {
         const std::uint32_t j = knn[q * k + t];
         if (j == ~std::uint32_t(0) || !(double(knn_d2[q * k + t]) < r2))
           continue;
         const std::uint64_t sj = window.m_base + j;
         if (sj < sp)
-          earlier.push_back({sj, knn_d2[q * k + t]});
+          batch_neighbors.push_back({sj, knn_d2[q * k + t]});
       }
-      while (rv < reverse.size() && reverse[rv].target < sp)
-        ++rv; // cannot happen: targets are later than every finalised point
       while (rv < reverse.size() && reverse[rv].target == sp) {
-        earlier.push_back({reverse[rv].source, reverse[rv].squared_distance});
+        batch_neighbors.push_back({reverse[rv].source, reverse[rv].squared_distance});
         ++rv;
       }
-      std::sort(earlier.begin(), earlier.end(),
+      auto first = batch_neighbors.begin() + std::ptrdiff_t(begin);
+      std::sort(first, batch_neighbors.end(),
                 [](const Sweep_neighbor& a, const Sweep_neighbor& b) { return a.sequence < b.sequence; });
-      earlier.erase(std::unique(earlier.begin(), earlier.end(),
-                                [](const Sweep_neighbor& a, const Sweep_neighbor& b) { return a.sequence == b.sequence; }),
-                    earlier.end());
-      report.number_of_edges += earlier.size();
-      visitor.finalize(window, sp, earlier);
+      batch_neighbors.erase(std::unique(first, batch_neighbors.end(),
+                                        [](const Sweep_neighbor& a, const Sweep_neighbor& b) {
+                                          return a.sequence == b.sequence;
+                                        }),
+                            batch_neighbors.end());
+      batch_first.push_back(batch_neighbors.size());
+    }
+    report.number_of_edges += batch_neighbors.size();
+    if constexpr (internal::Has_prepare<Visitor, Sweep_window<Payload>>::value)
+      visitor.prepare(window, finalized, batch_first, batch_neighbors);
+    for (std::size_t q = 0; q < count; ++q) {
+      earlier.assign(batch_neighbors.begin() + std::ptrdiff_t(batch_first[q]),
+                     batch_neighbors.begin() + std::ptrdiff_t(batch_first[q + 1]));
+      visitor.finalize(window, finalized + q, earlier);
     }
     reverse.erase(reverse.begin(), reverse.begin() + std::ptrdiff_t(rv));
     finalized = ready;
