@@ -381,7 +381,7 @@ int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
     std::printf("{\"input\": \"%s\", \"output\": \"%s\", \"mode\": \"stream\", \"points\": %llu, \"edges\": %llu, "
                 "\"segments\": %zu, \"segment_edges\": %zu, \"components\": %zu, \"peak_window\": %zu, \"k\": %u, "
                 "\"radius\": %.9g, \"radius_estimated\": %s, \"criterion\": \"%s\", \"solver\": \"%s\", "
-                "\"threads\": %d, \"energy_before\": %.9g, \"energy_after\": %.9g, \"flipped\": %llu, "
+                "\"threads\": %d, \"segment_energy_before\": %.9g, \"segment_energy_after\": %.9g, \"flipped\": %llu, "
                 "\"seconds\": {\"frame\": %.6f, \"radius\": %.6f, \"sort\": %.6f, \"sweep\": %.6f, \"solve\": %.6f, "
                 "\"sign\": %.6f, \"output\": %.6f, \"total\": %.6f}}\n",
                 json_escape(o.input).c_str(), json_escape(o.output).c_str(), (unsigned long long)r.number_of_points,

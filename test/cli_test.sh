@@ -72,6 +72,7 @@ done
 expect_exit 0 "stream" "$prog" --quiet --json --stream "$dir/sphere.xyz" "$dir/stream.xyz"
 check "stream json" grep -q '"mode": "stream"' "$dir/out.txt"
 check "stream json has segments" grep -q '"segments": ' "$dir/out.txt"
+check "stream json names the segment-graph energies" grep -q '"segment_energy_after": ' "$dir/out.txt"
 check "stream output is a permutation of the input with outward normals" awk '
   NR==FNR { key[sprintf("%.7f %.7f %.7f", $1, $2, $3)] = $4 " " $5 " " $6; n++; next }
   { k = sprintf("%.7f %.7f %.7f", $1, $2, $3); if (!(k in key) || seen[k]++ || $1*$4 + $2*$5 + $3*$6 <= 0) bad++;
