@@ -99,6 +99,10 @@ struct Options
   bool json = false, quiet = false, ascii = false;
   bool stream = false;
   bool sign_given = false;
+  std::string presorted;      // --stream: "", "x", "y" or "z"
+  std::string components_dir; // --stream: one file per component there
+  unsigned long long min_component_size = 0;
+  bool min_component_size_given = false;
 };
 
 const char* usage_text =
@@ -129,7 +133,20 @@ const char* usage_text =
   "  --stream             out of core, for clouds larger than memory: sort along the\n"
   "                       principal axis (temporary files in TMPDIR), sweep, segment,\n"
   "                       solve the segment graph; IN must have normals; OUT holds\n"
-  "                       the points in sweep order (outward sign only)\n"
+  "                       the points in sweep order (outward sign only); a one-line\n"
+  "                       progress (stage, percent) on stderr when it is a terminal\n"
+  "  --presorted x|y|z    with --stream: IN is already sorted by increasing x (y, z):\n"
+  "                       no principal axis, no external sort, the sweep reads IN as\n"
+  "                       it is and OUT keeps its order; an unsorted IN is an error\n"
+  "                       naming the first point out of order\n"
+  "  --components-dir DIR with --stream: also write each connected component to\n"
+  "                       DIR/component_000000.EXT, component_000001.EXT, ... (largest\n"
+  "                       first, EXT and format of OUT, each written atomically;\n"
+  "                       DIR is created when missing, files of the same names are\n"
+  "                       replaced)\n"
+  "  --min-component-size N  with --stream: drop the components of fewer than N\n"
+  "                       points from OUT and the component files (counted in the\n"
+  "                       report: dropped_points, dropped_components; default 0)\n"
   "  --ascii              write PLY as ascii instead of binary\n"
   "  --json               print one JSON object with the report on stdout\n"
   "  --quiet              print nothing on stderr but errors\n"
@@ -224,6 +241,20 @@ Options parse_options(int argc, char** argv)
       o.ascii = true;
     } else if (a == "--stream") {
       o.stream = true;
+    } else if (a == "--presorted") {
+      o.presorted = value();
+      if (o.presorted != "x" && o.presorted != "y" && o.presorted != "z")
+        throw Usage_error("unknown axis '" + o.presorted + "' for --presorted (x, y, z)");
+    } else if (a == "--components-dir") {
+      o.components_dir = value();
+      if (o.components_dir.empty())
+        throw Usage_error("--components-dir needs a directory");
+    } else if (a == "--min-component-size") {
+      const long long m = parse_number<long long>(a, value());
+      if (m < 0)
+        throw Usage_error("--min-component-size must be a number of points >= 0");
+      o.min_component_size = (unsigned long long)m;
+      o.min_component_size_given = true;
     } else if (a.size() > 1 && a[0] == '-') {
       throw Usage_error("unknown option " + a);
     } else {
@@ -236,6 +267,12 @@ Options parse_options(int argc, char** argv)
     throw Usage_error("--prior-weight needs --viewpoint");
   if (o.stream && (o.has_viewpoint || (o.sign_given && o.sign != "outward")))
     throw Usage_error("--stream orients every component outward: --sign keep and --viewpoint are not supported");
+  if (!o.stream && !o.presorted.empty())
+    throw Usage_error("--presorted needs --stream");
+  if (!o.stream && !o.components_dir.empty())
+    throw Usage_error("--components-dir needs --stream");
+  if (!o.stream && o.min_component_size_given)
+    throw Usage_error("--min-component-size needs --stream");
   if (positional.empty()) {
     o.input = NORMAL_ORIENTATION_SAMPLE_CLOUD;
     o.output = "sample_oriented.ply";
@@ -288,6 +325,61 @@ private:
   bool m_enabled;
   std::chrono::steady_clock::time_point m_start;
   int m_last = -1;
+  bool m_drawn = false;
+};
+
+/// The one-line progress of --stream on stderr: the stage and, when its
+/// size is known, a bar and a percentage, in the style of `Progress_bar`;
+/// drawn only when stderr is a terminal and the run lasts long enough, and
+/// erased when done (also when an error unwinds).
+class Stage_progress_line
+{
+public:
+  explicit Stage_progress_line(bool enabled)
+    : m_enabled(enabled && isatty(2)), m_start(std::chrono::steady_clock::now())
+  {}
+  ~Stage_progress_line() { finish(); }
+  Stage_progress_line(const Stage_progress_line&) = delete;
+  Stage_progress_line& operator=(const Stage_progress_line&) = delete;
+  bool operator()(const NO::Streaming_progress& p)
+  {
+    if (!m_enabled)
+      return true;
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - m_start).count() < 0.5)
+      return true;
+    const int percent = p.total > 0 ? int(p.fraction() * 100.0) : -1;
+    const bool same = p.stage == m_stage && percent == m_percent;
+    if (same && (percent >= 0 || std::chrono::duration<double>(now - m_drawn_at).count() < 0.25))
+      return true;
+    m_stage = p.stage;
+    m_percent = percent;
+    m_drawn_at = now;
+    char line[96];
+    if (percent >= 0) {
+      const int width = 40, filled = percent * width / 100;
+      std::snprintf(line, sizeof line, "%-10s [%s%s] %3d%%", NO::streaming_stage_name(p.stage),
+                    std::string(std::size_t(filled), '#').c_str(), std::string(std::size_t(width - filled), ' ').c_str(),
+                    percent);
+    } else
+      std::snprintf(line, sizeof line, "%-10s %llu points", NO::streaming_stage_name(p.stage),
+                    (unsigned long long)p.done);
+    std::fprintf(stderr, "\r%-60s", line);
+    m_drawn = true;
+    return true;
+  }
+  void finish()
+  {
+    if (m_drawn)
+      std::fprintf(stderr, "\r%60s\r", "");
+    m_drawn = false;
+  }
+
+private:
+  bool m_enabled;
+  std::chrono::steady_clock::time_point m_start, m_drawn_at;
+  NO::Streaming_stage m_stage = NO::Streaming_stage::SCAN;
+  int m_percent = -2;
   bool m_drawn = false;
 };
 
@@ -347,6 +439,14 @@ int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
   NO::Streaming_options so;
   so.number_of_neighbors = o.k;
   so.radius = o.radius;
+  so.presorted_axis = o.presorted == "x"   ? NO::Presorted_axis::X
+                      : o.presorted == "y" ? NO::Presorted_axis::Y
+                      : o.presorted == "z" ? NO::Presorted_axis::Z
+                                           : NO::Presorted_axis::NONE;
+  so.minimum_component_size = o.min_component_size;
+  so.component_files.directory = o.components_dir; // in OUT's format
+  Stage_progress_line progress(!o.quiet);
+  so.callback = [&progress](const NO::Streaming_progress& p) { return progress(p); };
   NO::IO::Point_stream_write_options wo;
   wo.binary = !o.ascii;
   NO::Streaming_result r;
@@ -365,31 +465,48 @@ int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
     else
       r = with_solver(NO::Hoppe_criterion());
   });
+  progress.finish();
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!o.quiet) {
     std::fprintf(stderr,
-                 "oriented %llu points out of core: %llu edges (k = %u, r = %.6g), %zu segments, %zu component%s, "
+                 "oriented %llu points out of core%s: %llu edges (k = %u, r = %.6g), %zu segments, %zu component%s, "
                  "peak window %zu points, %llu normals flipped, %.3f s\n",
-                 (unsigned long long)r.number_of_points, (unsigned long long)r.number_of_edges, o.k, r.neighbor_radius,
-                 r.number_of_segments, r.number_of_components, r.number_of_components == 1 ? "" : "s", r.peak_window,
+                 (unsigned long long)r.number_of_points, r.presorted ? " (presorted input)" : "",
+                 (unsigned long long)r.number_of_edges, o.k, r.neighbor_radius, r.number_of_segments,
+                 r.number_of_components, r.number_of_components == 1 ? "" : "s", r.peak_window,
                  (unsigned long long)r.number_of_flipped, total);
+    if (r.number_of_dropped_components > 0)
+      std::fprintf(stderr, "dropped %zu component%s of fewer than %llu points (%llu points)\n",
+                   r.number_of_dropped_components, r.number_of_dropped_components == 1 ? "" : "s",
+                   o.min_component_size, (unsigned long long)r.number_of_dropped_points);
     std::error_code ec;
     const std::string where = std::filesystem::absolute(o.output, ec).string();
     std::fprintf(stderr, "wrote %s\n", ec ? o.output.c_str() : where.c_str());
+    if (!o.components_dir.empty()) {
+      const std::string dir = std::filesystem::absolute(o.components_dir, ec).string();
+      std::fprintf(stderr, "wrote %zu component file%s in %s\n", r.component_files.size(),
+                   r.component_files.size() == 1 ? "" : "s", ec ? o.components_dir.c_str() : dir.c_str());
+    }
   }
   if (o.json)
     std::printf("{\"input\": \"%s\", \"output\": \"%s\", \"mode\": \"stream\", \"points\": %llu, \"edges\": %llu, "
-                "\"segments\": %zu, \"segment_edges\": %zu, \"components\": %zu, \"peak_window\": %zu, \"k\": %u, "
+                "\"segments\": %zu, \"segment_edges\": %zu, \"components\": %zu, \"dropped_components\": %zu, "
+                "\"dropped_points\": %llu, \"min_component_size\": %llu, \"component_files\": %zu, "
+                "\"components_dir\": %s, \"presorted\": %s, \"peak_window\": %zu, \"k\": %u, "
                 "\"radius\": %.9g, \"radius_estimated\": %s, \"criterion\": \"%s\", \"solver\": \"%s\", "
                 "\"threads\": %d, \"segment_energy_before\": %.9g, \"segment_energy_after\": %.9g, \"flipped\": %llu, "
                 "\"seconds\": {\"frame\": %.6f, \"radius\": %.6f, \"sort\": %.6f, \"sweep\": %.6f, \"solve\": %.6f, "
-                "\"sign\": %.6f, \"output\": %.6f, \"total\": %.6f}}\n",
+                "\"sign\": %.6f, \"output\": %.6f, \"components\": %.6f, \"total\": %.6f}}\n",
                 json_escape(o.input).c_str(), json_escape(o.output).c_str(), (unsigned long long)r.number_of_points,
                 (unsigned long long)r.number_of_edges, r.number_of_segments, r.number_of_segment_edges,
-                r.number_of_components, r.peak_window, o.k, r.neighbor_radius, r.radius_estimated ? "true" : "false",
+                r.number_of_components, r.number_of_dropped_components,
+                (unsigned long long)r.number_of_dropped_points, o.min_component_size, r.component_files.size(),
+                o.components_dir.empty() ? "null" : ("\"" + json_escape(o.components_dir) + "\"").c_str(),
+                o.presorted.empty() ? "null" : ("\"" + o.presorted + "\"").c_str(), r.peak_window, o.k,
+                r.neighbor_radius, r.radius_estimated ? "true" : "false",
                 o.criterion.c_str(), o.solver.c_str(), o.threads, r.segment_energy_before, r.segment_energy_after,
                 (unsigned long long)r.number_of_flipped, r.seconds.frame, r.seconds.radius, r.seconds.sort,
-                r.seconds.sweep, r.seconds.solve, r.seconds.sign, r.seconds.output, total);
+                r.seconds.sweep, r.seconds.solve, r.seconds.sign, r.seconds.output, r.seconds.components, total);
   return 0;
 }
 

@@ -88,6 +88,60 @@ expect_exit 1 "stream needs normals" "$prog" --quiet --stream "$dir/nonormals.xy
 check "no output after a failed stream" test ! -e "$dir/none.xyz"
 expect_exit 2 "stream refuses --viewpoint" "$prog" --quiet --stream --viewpoint 0,0,0 "$dir/sphere.xyz" "$dir/none.xyz"
 check "no temporary files left in TMPDIR" test -z "$(ls -A "$dir/tmp" 2>/dev/null)"
+# no progress line when stderr is not a terminal
+expect_exit 0 "stream, not quiet" "$prog" --json --stream "$dir/sphere.xyz" "$dir/loud.xyz"
+check "no progress line on a stderr that is not a terminal" test "$(tr -cd '\r' < "$dir/err.txt" | wc -c)" -eq 0
+check "stream summary on stderr" grep -q "oriented 600 points out of core" "$dir/err.txt"
+check "stream json is one line" test "$(wc -l < "$dir/out.txt")" -eq 1
+
+# --presorted: a file sorted by x gives the same oriented points as the sorted
+# path, in its own order; an unsorted one fails at once
+sort -g -k1,1 "$dir/sphere.xyz" > "$dir/sphere_x.xyz"
+expect_exit 0 "stream --presorted x" "$prog" --quiet --json --stream --presorted x "$dir/sphere_x.xyz" "$dir/presorted.xyz"
+check "json says presorted x" grep -q '"presorted": "x"' "$dir/out.txt"
+check "presorted output keeps the input order" awk 'NR==FNR { k[FNR] = $1 " " $2 " " $3; n++; next }
+  { if (sprintf("%.7f %.7f %.7f", $1, $2, $3) != k[FNR]) bad++; c++ } END { exit (bad > 0 || c != n) }' \
+  "$dir/sphere_x.xyz" "$dir/presorted.xyz"
+check "presorted: same oriented points as the sorted path" cmp -s <(sort "$dir/stream.xyz") <(sort "$dir/presorted.xyz")
+expect_exit 1 "--presorted x on an unsorted file" "$prog" --quiet --stream --presorted x "$dir/sphere.xyz" "$dir/unsorted.xyz"
+check "one-line error for an unsorted --presorted input" test "$(wc -l < "$dir/err.txt")" -eq 1
+check "the error says the input is not sorted" grep -q "not sorted by increasing x" "$dir/err.txt"
+check "no output for an unsorted --presorted input" test -z "$(find "$dir" -name 'unsorted.xyz*')"
+check "no temporary files after an unsorted --presorted input" test -z "$(ls -A "$dir/tmp")"
+
+# --components-dir and --min-component-size: two spheres (800 and 400 points)
+# and three isolated points
+awk 'BEGIN { srand(7); for (i = 0; i < 1200; i++) { c = (i < 800) ? 0 : 4; R = (i < 800) ? 1 : 0.7;
+  z = 2*rand()-1; a = 6.2831853*rand(); r = sqrt(1-z*z); x = r*cos(a); y = r*sin(a); s = (rand() < 0.5) ? -1 : 1;
+  printf "%.7f %.7f %.7f %.7f %.7f %.7f\n", c + R*x, R*y, R*z, s*x, s*y, s*z }
+  for (i = 0; i < 3; i++) printf "%.7f 5.0000000 5.0000000 0 0 1\n", 10 + 3*i }' > "$dir/parts.xyz"
+expect_exit 0 "components and a minimum size" "$prog" --quiet --json --stream --radius 0.5 --min-component-size 10 \
+  --components-dir "$dir/comps" "$dir/parts.xyz" "$dir/parts_out.xyz"
+check "json counts the dropped points" grep -q '"dropped_points": 3,' "$dir/out.txt"
+check "json counts the dropped components" grep -q '"dropped_components": 3,' "$dir/out.txt"
+check "json counts the component files" grep -q '"component_files": 2,' "$dir/out.txt"
+check "one file per kept component, nothing else" test "$(ls "$dir/comps" | tr '\n' ' ')" = "component_000000.xyz component_000001.xyz "
+check "the largest component first" test "$(wc -l < "$dir/comps/component_000000.xyz")" -eq 800
+check "the second component" test "$(wc -l < "$dir/comps/component_000001.xyz")" -eq 400
+check "the output without the dropped points" test "$(wc -l < "$dir/parts_out.xyz")" -eq 1200
+check "the component files hold the output" cmp -s <(sort "$dir/parts_out.xyz") <(cat "$dir"/comps/*.xyz | sort)
+check "components face outward" awk '{ c = (FILENAME ~ /000000/) ? 0 : 4; if (($1-c)*$4 + $2*$5 + $3*$6 <= 0) bad++ }
+  END { exit bad > 0 }' "$dir/comps/component_000000.xyz" "$dir/comps/component_000001.xyz"
+expect_exit 0 "component files in the output's format (binary ply)" "$prog" --quiet --stream --radius 0.5 \
+  --min-component-size 10 --components-dir "$dir/comps_ply" "$dir/parts.xyz" "$dir/parts_out.ply"
+check "ply component file" test "$(head -c 3 "$dir/comps_ply/component_000001.ply")" = "ply"
+expect_exit 0 "a component file reads back" "$prog" --quiet --stream "$dir/comps_ply/component_000001.ply" "$dir/back.xyz"
+check "it holds the component" test "$(wc -l < "$dir/back.xyz")" -eq 400
+expect_exit 0 "components without a minimum" "$prog" --quiet --json --stream --radius 0.5 --components-dir "$dir/comps_all" \
+  "$dir/parts.xyz" "$dir/parts_all.xyz"
+check "every component kept without a minimum" test "$(ls "$dir/comps_all" | wc -l)" -eq 5
+check "nothing dropped without a minimum" grep -q '"dropped_points": 0,' "$dir/out.txt"
+touch "$dir/a_file"
+expect_exit 1 "--components-dir on a file" "$prog" --quiet --stream --components-dir "$dir/a_file" "$dir/parts.xyz" "$dir/nodir.xyz"
+check "one-line error for --components-dir on a file" test "$(wc -l < "$dir/err.txt")" -eq 1
+check "no output when the components cannot be written" test -z "$(find "$dir" -name 'nodir.xyz*')"
+check "no temporary files after the component runs" test -z "$(ls -A "$dir/tmp")"
+check "no temporary component file left" test -z "$(find "$dir"/comps* -name '*.tmp*')"
 
 # SIGTERM during a streamed run: no output, no temporary file left
 awk 'BEGIN { srand(5); for (i = 0; i < 400000; i++) { z = 2*rand()-1; a = 6.2831853*rand(); r = sqrt(1-z*z);
@@ -104,13 +158,29 @@ if [ ! -e "$dir/big_out.ply" ]; then
   check "no temporary files after SIGTERM" test -z "$(ls -A "$dir/tmp")"
 fi
 
+# the progress line of --stream on a terminal (through script(1), when there):
+# stages and percentages on stderr, erased at the end, never in the JSON on
+# stdout; nothing with --quiet
+if command -v script > /dev/null 2>&1; then
+  script -qfec "'$prog' --json --stream '$dir/big.xyz' '$dir/big_tty.ply' > '$dir/tty_json.txt'" /dev/null > "$dir/tty.txt" 2>&1
+  check "progress on a terminal names the sweep" grep -q "sweep .*%" "$dir/tty.txt"
+  check "the progress line is erased before the summary" grep -q $'\r *\roriented 400000 points' "$dir/tty.txt"
+  check "no progress in the JSON on stdout" test "$(tr -cd '\r' < "$dir/tty_json.txt" | wc -c)" -eq 0
+  check "the JSON is one line" test "$(wc -l < "$dir/tty_json.txt")" -eq 1
+  script -qfec "'$prog' --quiet --stream '$dir/big.xyz' '$dir/big_tty.ply'" /dev/null > "$dir/tty_quiet.txt" 2>&1
+  check "nothing on a terminal with --quiet" test ! -s "$dir/tty_quiet.txt"
+fi
+
 # points without normals: estimated first
 awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/bare.xyz"
 expect_exit 0 "estimates missing normals" "$prog" --quiet --normals pca "$dir/bare.xyz" "$dir/bare_out.xyz"
 check "estimated normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/bare_out.xyz"
 
-# bad options: exit 2, one line on stderr, no output
-for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads 0" "--bogus" "--viewpoint 1,2" "--prior-weight 1" "--viewpoint 0,0,0 --prior-weight -1" "--viewpoint 0,0,0 --prior-weight nan"; do
+# bad options: exit 2, one line on stderr, no output (the options of --stream
+# need it)
+for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads 0" "--bogus" "--viewpoint 1,2" "--prior-weight 1" "--viewpoint 0,0,0 --prior-weight -1" "--viewpoint 0,0,0 --prior-weight nan" \
+    "--presorted x" "--stream --presorted w" "--stream --presorted" "--components-dir $dir/cd" "--min-component-size 5" \
+    "--stream --min-component-size -1" "--stream --min-component-size x"; do
   # shellcheck disable=SC2086
   expect_exit 2 "bad option $args" "$prog" $args "$dir/sphere.xyz" "$dir/bad_opt.xyz"
   check "one-line error for $args" test "$(wc -l < "$dir/err.txt")" -eq 1

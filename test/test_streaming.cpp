@@ -3,9 +3,12 @@
 /// \brief Tests of Normal_orientation/streaming/external_sort.h: the sweep frame,
 /// the external sort (runs, merges, in-memory case), degenerate clouds, the
 /// temporary files (creation, removal on success, on exceptions, on write
-/// failures, from a signal handler) and determinism.
+/// failures, from a signal handler) and determinism; and of the options of
+/// streaming_orient_normals.h: presorted input, component files and the
+/// minimum component size, progress and cancellation, and the bounded window.
 
 #include <Normal_orientation/streaming/external_sort.h>
+#include <Normal_orientation/streaming_orient_normals.h>
 
 #include "Test_directory.h"
 
@@ -20,8 +23,12 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iostream>
+#include <iterator>
 #include <limits>
+#include <map>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -62,18 +69,22 @@ public:
     chunk.insert(chunk.end(), records_.begin() + std::ptrdiff_t(position_),
                  records_.begin() + std::ptrdiff_t(position_ + n));
     position_ += n;
+    delivered_ += n;
     return n;
   }
   void rewind() { position_ = 0; }
 
   std::size_t position() const { return position_; }
   const std::vector<Point_record>& records() const { return records_; }
+  /// the number of records delivered since the construction, over all passes
+  std::uint64_t delivered() const { return delivered_; }
 
   std::function<void(std::size_t)> on_read;
 
 private:
   std::vector<Point_record> records_;
   std::size_t position_ = 0;
+  std::uint64_t delivered_ = 0;
 };
 
 Point_record make_record(const Vec& p, std::uint64_t index)
@@ -661,6 +672,531 @@ TEST(Determinism, SameInputSameOutput)
   ns::Sorted_run_reader reader_1 = ns::external_sort(first, frame_1, options_with(1500, directory.path()));
   ns::Sorted_run_reader reader_2 = ns::external_sort(second, frame_2, options_with(1500, directory.path()));
   expect_identical(read_all(reader_1, 512), read_all(reader_2, 2048));
+}
+
+// ---------------------------------------------------------------------------
+// (f) streaming_orient_normals: presorted input, component files, minimum
+//     component size, progress and cancellation, bounded window
+// ---------------------------------------------------------------------------
+
+namespace NO = Normal_orientation;
+
+/// a record with the given position, normal and index
+Point_record oriented_record(const Vec& p, const Vec& n, std::uint64_t index)
+{
+  Point_record r;
+  for (int k = 0; k < 3; ++k) {
+    r.position[k] = p[k];
+    r.normal[k] = n[k];
+  }
+  r.index = index;
+  return r;
+}
+
+/// A cloud with its true outward normals (`truth[index]`), the records
+/// carrying them with random signs, indices 0..n-1 in the order of `records`.
+struct Test_cloud
+{
+  std::vector<Point_record> records;
+  std::vector<Vec> truth;
+  /// appends a point of true normal `n`, its sign drawn by `rng`
+  void add(const Vec& p, const Vec& n, std::mt19937_64& rng)
+  {
+    const double s = (rng() & 1) ? 1.0 : -1.0;
+    records.push_back(oriented_record(p, Vec{{s * n[0], s * n[1], s * n[2]}}, records.size()));
+    truth.push_back(n);
+  }
+  /// the points of an ellipsoid of semi-axes a, b, c centred at `c0`
+  void ellipsoid(std::size_t n, const Vec& c0, double a, double b, double c, std::mt19937_64& rng)
+  {
+    std::normal_distribution<double> g;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Vec d = normalized(Vec{{g(rng), g(rng), g(rng)}});
+      add(Vec{{c0[0] + a * d[0], c0[1] + b * d[1], c0[2] + c * d[2]}},
+          normalized(Vec{{d[0] / a, d[1] / b, d[2] / c}}), rng);
+    }
+  }
+  /// the number of records of `out` whose normal does not face outward
+  std::size_t wrong(const std::vector<Point_record>& out) const
+  {
+    std::size_t w = 0;
+    for (const Point_record& r : out)
+      w += dot(Vec{{r.normal[0], r.normal[1], r.normal[2]}}, truth[r.index]) <= 0.0 ? 1 : 0;
+    return w;
+  }
+};
+
+/// `records` sorted by coordinate `axis` (ties: by index)
+std::vector<Point_record> sorted_by(std::vector<Point_record> records, int axis)
+{
+  std::sort(records.begin(), records.end(), [axis](const Point_record& a, const Point_record& b) {
+    return a.position[axis] != b.position[axis] ? a.position[axis] < b.position[axis] : a.index < b.index;
+  });
+  return records;
+}
+
+/// options whose temporary files all go to `directory`
+NO::Streaming_options streaming_options_in(const std::string& directory)
+{
+  NO::Streaming_options options;
+  options.temporary_directory = directory;
+  options.sort.temporary_directory = directory;
+  return options;
+}
+
+/// runs streaming_orient_normals on `source`, collecting the sink's records
+NO::Streaming_result stream(Vector_source& source, const NO::Streaming_options& options,
+                            std::vector<Point_record>& out)
+{
+  out.clear();
+  auto sink = [&out](const Point_record& r) { out.push_back(r); };
+  return NO::streaming_orient_normals(source, sink, options);
+}
+
+/// writes `records` to the point file `path`
+void write_cloud(const std::string& path, const std::vector<Point_record>& records)
+{
+  NO::IO::Point_stream_writer writer(path);
+  writer.write(records);
+  writer.commit();
+}
+
+/// reads every record of the point file `path`
+std::vector<Point_record> read_cloud(const std::string& path)
+{
+  NO::IO::Point_stream_reader reader(path);
+  return read_all(reader, 4096);
+}
+
+/// the positions of `records`, sorted (to compare clouds whatever their order)
+std::vector<std::array<double, 6>> sorted_points(const std::vector<Point_record>& records)
+{
+  std::vector<std::array<double, 6>> v;
+  for (const Point_record& r : records)
+    v.push_back({{r.position[0], r.position[1], r.position[2], r.normal[0], r.normal[1], r.normal[2]}});
+  std::sort(v.begin(), v.end());
+  return v;
+}
+
+/// the bytes of the file `path`
+std::string file_bytes(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+TEST(Streaming_presorted, SameOrientationAsTheSortedPath)
+{
+  Temporary_directory directory;
+  std::mt19937_64 rng(17);
+  Test_cloud cloud;
+  cloud.ellipsoid(20000, Vec{{1., -2., 0.5}}, 4., 1., 0.7, rng);
+  const std::size_t n = cloud.records.size();
+
+  // the reference: the input in random order, sorted by the pipeline
+  std::vector<Point_record> shuffled = cloud.records;
+  std::shuffle(shuffled.begin(), shuffled.end(), rng);
+  Vector_source source(shuffled);
+  NO::Streaming_options options = streaming_options_in(directory.path());
+  options.batch_size = 2000;
+  options.sort.memory_budget = 5000 * sizeof(ns::internal::Keyed_record); // several runs
+  std::vector<Point_record> reference;
+  const NO::Streaming_result ref = stream(source, options, reference);
+  ASSERT_EQ(reference.size(), n);
+  EXPECT_FALSE(ref.presorted);
+  EXPECT_TRUE(ref.radius_estimated);
+  EXPECT_EQ(cloud.wrong(reference), 0u);
+  EXPECT_EQ(source.delivered(), 2 * n); // the first pass and the sort
+  std::vector<Vec> normal(n);
+  for (const Point_record& r : reference)
+    normal[r.index] = Vec{{r.normal[0], r.normal[1], r.normal[2]}};
+  EXPECT_EQ(directory.count(), 0u);
+
+  const NO::Presorted_axis axes[3] = {NO::Presorted_axis::X, NO::Presorted_axis::Y, NO::Presorted_axis::Z};
+  for (int axis = 0; axis < 3; ++axis) {
+    SCOPED_TRACE(axis);
+    Vector_source presorted(sorted_by(cloud.records, axis));
+    NO::Streaming_options po = options;
+    po.presorted_axis = axes[axis];
+    po.sort.memory_budget = 16 * sizeof(ns::internal::Keyed_record); // would make runs: it must not sort
+    std::size_t most_files = 0;
+    presorted.on_read = [&](std::size_t) { most_files = std::max(most_files, directory.count()); };
+    std::vector<Point_record> out;
+    const NO::Streaming_result r = stream(presorted, po, out);
+    EXPECT_TRUE(r.presorted);
+    EXPECT_EQ(presorted.delivered(), 2 * n); // the first pass and the sweep
+    EXPECT_LE(most_files, 1u);               // the record file only: no sort runs
+    EXPECT_EQ(r.seconds.sort, 0.0);
+    // the same radius (the sample is the whole cloud), hence the same graph
+    EXPECT_EQ(r.neighbor_radius, ref.neighbor_radius);
+    EXPECT_EQ(r.number_of_points, ref.number_of_points);
+    EXPECT_EQ(r.number_of_edges, ref.number_of_edges);
+    EXPECT_EQ(r.number_of_components, ref.number_of_components);
+    EXPECT_LT(r.peak_window, n);
+    // the output keeps the input order, with the same sign for every input index
+    ASSERT_EQ(out.size(), n);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      EXPECT_EQ(out[i].index, presorted.records()[i].index);
+      const Point_record& in = presorted.records()[i];
+      EXPECT_EQ(std::memcmp(out[i].position, in.position, sizeof in.position), 0);
+      const Vec& want = normal[out[i].index];
+      differ += (out[i].normal[0] != want[0] || out[i].normal[1] != want[1] || out[i].normal[2] != want[2]) ? 1 : 0;
+    }
+    EXPECT_EQ(differ, 0u);
+    EXPECT_EQ(cloud.wrong(out), 0u);
+    EXPECT_EQ(directory.count(), 0u);
+  }
+}
+
+TEST(Streaming_presorted, UnsortedInputFailsEarlyWithAClearError)
+{
+  Temporary_directory directory, files;
+  std::mt19937_64 rng(18);
+  Test_cloud cloud;
+  cloud.ellipsoid(5000, Vec{{0., 0., 0.}}, 3., 1., 1., rng);
+  std::vector<Point_record> records = sorted_by(cloud.records, 0);
+  std::swap(records[1500], records[1700]);
+  NO::Streaming_options options = streaming_options_in(directory.path());
+  options.presorted_axis = NO::Presorted_axis::X;
+  std::size_t sunk = 0;
+  auto sink = [&sunk](const Point_record&) { ++sunk; };
+  Vector_source source(records);
+  try {
+    NO::streaming_orient_normals(source, sink, options);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("not sorted by increasing x"), std::string::npos) << what;
+    // the first point out of order is the one at 1501, below the one moved to 1500
+    EXPECT_NE(what.find("point 1501 (input index " + std::to_string(records[1501].index) + ")"), std::string::npos)
+      << what;
+    EXPECT_EQ(what.find('\n'), std::string::npos);
+  }
+  EXPECT_EQ(sunk, 0u);
+  EXPECT_LE(source.delivered(), records.size()); // found by the first pass, before any sweep
+  EXPECT_EQ(directory.count(), 0u);
+
+  // from files: no output, no temporary file
+  write_cloud(files.file("in.ply"), records);
+  options.component_files.directory = files.file("components");
+  EXPECT_THROW(NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), options), std::runtime_error);
+  EXPECT_EQ(files.listing(), std::vector<std::string>{"in.ply"});
+  EXPECT_EQ(directory.count(), 0u);
+  // sorted along y, it is not sorted along x, but it is along y
+  write_cloud(files.file("in_y.ply"), sorted_by(cloud.records, 1));
+  options.component_files.directory.clear();
+  EXPECT_THROW(NO::streaming_orient_files(files.file("in_y.ply"), files.file("out.ply"), options), std::runtime_error);
+  options.presorted_axis = NO::Presorted_axis::Y;
+  const NO::Streaming_result r = NO::streaming_orient_files(files.file("in_y.ply"), files.file("out.ply"), options);
+  EXPECT_EQ(r.number_of_points, records.size());
+  EXPECT_EQ(read_cloud(files.file("out.ply")).size(), records.size());
+  EXPECT_EQ(directory.count(), 0u);
+}
+
+/// two ellipsoids of 3000 and 1500 points and six isolated points
+Test_cloud two_bodies_and_dust(std::mt19937_64& rng)
+{
+  Test_cloud cloud;
+  cloud.ellipsoid(3000, Vec{{0., 0., 0.}}, 1.5, 1., 1., rng);
+  cloud.ellipsoid(1500, Vec{{5., 0., 0.}}, 0.8, 0.8, 0.8, rng);
+  for (int i = 0; i < 6; ++i)
+    cloud.add(Vec{{20. + 3. * i, 1., -1.}}, Vec{{0., 0., 1.}}, rng);
+  std::shuffle(cloud.records.begin(), cloud.records.end(), rng);
+  return cloud;
+}
+
+TEST(Streaming_components, MinimumSizeDropsSmallComponentsFromEveryOutput)
+{
+  Temporary_directory directory, files;
+  std::mt19937_64 rng(19);
+  const Test_cloud cloud = two_bodies_and_dust(rng);
+  const std::size_t n = cloud.records.size();
+  write_cloud(files.file("in.ply"), cloud.records);
+  NO::Streaming_options options = streaming_options_in(directory.path());
+  options.radius = 0.3;
+  options.minimum_component_size = 10;
+  options.component_files.directory = files.file("parts/a"); // created, with its parent
+  const NO::Streaming_result r = NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), options);
+  EXPECT_EQ(r.number_of_points, n);
+  EXPECT_EQ(r.number_of_components, 8u);
+  EXPECT_EQ(r.number_of_dropped_components, 6u);
+  EXPECT_EQ(r.number_of_dropped_points, 6u);
+  const std::vector<Point_record> out = read_cloud(files.file("out.ply"));
+  EXPECT_EQ(out.size(), n - 6);
+  for (const Point_record& p : out)
+    EXPECT_LT(p.position[0], 10.); // no dust
+  ASSERT_EQ(r.component_files.size(), 2u);
+  EXPECT_EQ(r.component_files[0], files.file("parts/a/component_000000.ply"));
+  EXPECT_EQ(r.component_files[1], files.file("parts/a/component_000001.ply"));
+  const std::vector<Point_record> big = read_cloud(r.component_files[0]), small = read_cloud(r.component_files[1]);
+  EXPECT_EQ(big.size(), 3000u); // the largest first
+  EXPECT_EQ(small.size(), 1500u);
+  for (const Point_record& p : big)
+    EXPECT_LT(p.position[0], 2.);
+  for (const Point_record& p : small)
+    EXPECT_GT(p.position[0], 3.);
+  // together, exactly the output (same coordinates and normals)
+  std::vector<Point_record> both = big;
+  both.insert(both.end(), small.begin(), small.end());
+  EXPECT_EQ(sorted_points(both), sorted_points(out));
+  std::vector<std::string> listing;
+  for (const auto& e : fs::directory_iterator(files.file("parts/a")))
+    listing.push_back(e.path().filename().string());
+  std::sort(listing.begin(), listing.end());
+  EXPECT_EQ(listing, (std::vector<std::string>{"component_000000.ply", "component_000001.ply"}));
+  EXPECT_EQ(directory.count(), 0u);
+
+  // one open file at a time (groups of one component, written in rounds):
+  // the same bytes; and xyz files like the output
+  const std::string first = file_bytes(r.component_files[0]), second = file_bytes(r.component_files[1]);
+  options.component_files.maximum_open_files = 1;
+  options.component_files.directory = files.file("parts/b");
+  const NO::Streaming_result r1 = NO::streaming_orient_files(files.file("in.ply"), files.file("out1.ply"), options);
+  ASSERT_EQ(r1.component_files.size(), 2u);
+  EXPECT_EQ(file_bytes(r1.component_files[0]), first);
+  EXPECT_EQ(file_bytes(r1.component_files[1]), second);
+  EXPECT_EQ(file_bytes(files.file("out1.ply")), file_bytes(files.file("out.ply")));
+  options.component_files.directory = files.file("parts/c");
+  const NO::Streaming_result rx = NO::streaming_orient_files(files.file("in.ply"), files.file("out.xyz"), options);
+  ASSERT_EQ(rx.component_files.size(), 2u);
+  EXPECT_EQ(rx.component_files[1], files.file("parts/c/component_000001.xyz"));
+  EXPECT_EQ(read_cloud(rx.component_files[1]).size(), 1500u);
+  EXPECT_EQ(directory.count(), 0u);
+
+  // without a minimum, every component is kept: the dust too, one point per file
+  options.minimum_component_size = 0;
+  options.component_files.maximum_open_files = 3;
+  options.component_files.directory = files.file("parts/d");
+  const NO::Streaming_result r0 = NO::streaming_orient_files(files.file("in.ply"), files.file("out0.ply"), options);
+  EXPECT_EQ(r0.number_of_dropped_components, 0u);
+  EXPECT_EQ(r0.number_of_dropped_points, 0u);
+  EXPECT_EQ(read_cloud(files.file("out0.ply")).size(), n);
+  ASSERT_EQ(r0.component_files.size(), 8u);
+  EXPECT_EQ(file_bytes(r0.component_files[0]), first);
+  EXPECT_EQ(file_bytes(r0.component_files[1]), second);
+  for (std::size_t c = 2; c < 8; ++c)
+    EXPECT_EQ(read_cloud(r0.component_files[c]).size(), 1u);
+  EXPECT_EQ(directory.count(), 0u);
+  // a bad extension is refused before any work
+  options.component_files.extension = ".obj";
+  Vector_source source(cloud.records);
+  std::vector<Point_record> sunk;
+  EXPECT_THROW(stream(source, options, sunk), std::invalid_argument);
+  EXPECT_EQ(source.delivered(), 0u);
+}
+
+TEST(Streaming_components, ManyComponentsWithFewOpenFiles)
+{
+  Temporary_directory directory, parts;
+  std::mt19937_64 rng(20);
+  Test_cloud cloud;
+  const int clusters = 40;
+  for (int c = 0; c < clusters; ++c) // 40 small spheres of 30 to 69 points, 3 apart along x
+    cloud.ellipsoid(30 + std::size_t(c), Vec{{3. * c, 0., 0.}}, 0.2, 0.2, 0.2, rng);
+  std::shuffle(cloud.records.begin(), cloud.records.end(), rng);
+  const std::size_t n = cloud.records.size();
+  Vector_source source(cloud.records);
+  NO::Streaming_options options = streaming_options_in(directory.path());
+  options.radius = 0.3;
+  options.batch_size = 100;
+  options.component_files.directory = parts.path();
+  options.component_files.maximum_open_files = 3; // 14 groups of 3, in 5 rounds
+  std::size_t most_open = 0, most_temporary = 0;
+  options.callback = [&](const NO::Streaming_progress& p) {
+    if (p.stage == NO::Streaming_stage::COMPONENTS) {
+      std::size_t open = 0;
+      for (const std::string& f : parts.listing())
+        open += f.find(".tmp.") != std::string::npos ? 1 : 0;
+      most_open = std::max(most_open, open);
+      most_temporary = std::max(most_temporary, directory.count());
+    }
+    return true;
+  };
+  std::vector<Point_record> out;
+  const NO::Streaming_result r = stream(source, options, out);
+  EXPECT_EQ(r.number_of_components, std::size_t(clusters));
+  ASSERT_EQ(r.component_files.size(), std::size_t(clusters));
+  EXPECT_GT(most_open, 0u);
+  EXPECT_LE(most_open, 3u);
+  EXPECT_LE(most_temporary, 1u + 3u); // the record file and the group files of a round
+  EXPECT_EQ(parts.count(), std::size_t(clusters));
+  EXPECT_EQ(directory.count(), 0u);
+  std::size_t total = 0, previous = n;
+  std::vector<int> file_of(clusters, -1);
+  for (std::size_t f = 0; f < r.component_files.size(); ++f) {
+    char name[48];
+    std::snprintf(name, sizeof name, "component_%06zu.ply", f);
+    EXPECT_EQ(r.component_files[f], parts.file(name));
+    const std::vector<Point_record> part = read_cloud(r.component_files[f]);
+    ASSERT_FALSE(part.empty());
+    EXPECT_LE(part.size(), previous); // by decreasing size
+    previous = part.size();
+    total += part.size();
+    const int c = int(std::lround(part[0].position[0] / 3.));
+    for (const Point_record& p : part)
+      EXPECT_EQ(int(std::lround(p.position[0] / 3.)), c); // one cluster per file
+    ASSERT_GE(c, 0);
+    ASSERT_LT(c, clusters);
+    EXPECT_EQ(file_of[std::size_t(c)], -1);
+    file_of[std::size_t(c)] = int(f);
+    EXPECT_EQ(part.size(), 30u + std::size_t(c));
+  }
+  EXPECT_EQ(total, n);
+  EXPECT_EQ(out.size(), n);
+}
+
+TEST(Streaming_progress, ReportsEveryStageInOrderAndCancels)
+{
+  Temporary_directory directory, files;
+  std::mt19937_64 rng(21);
+  Test_cloud cloud = two_bodies_and_dust(rng);
+  const std::size_t n = cloud.records.size();
+  NO::Streaming_options options = streaming_options_in(directory.path());
+  options.batch_size = 300;
+  options.sort.memory_budget = 1000 * sizeof(ns::internal::Keyed_record);
+  std::vector<NO::Streaming_progress> log;
+  options.callback = [&log](const NO::Streaming_progress& p) {
+    log.push_back(p);
+    return true;
+  };
+  std::vector<Point_record> out;
+  {
+    Vector_source source(cloud.records);
+    stream(source, options, out);
+  }
+  const NO::Streaming_stage order[] = {NO::Streaming_stage::SCAN,  NO::Streaming_stage::RADIUS,
+                                       NO::Streaming_stage::SORT,  NO::Streaming_stage::SWEEP,
+                                       NO::Streaming_stage::SOLVE, NO::Streaming_stage::SIGN,
+                                       NO::Streaming_stage::OUTPUT};
+  auto check_log = [&](const std::vector<NO::Streaming_stage>& expected) {
+    std::vector<NO::Streaming_stage> stages;
+    for (std::size_t i = 0; i < log.size(); ++i) {
+      const NO::Streaming_progress& p = log[i];
+      EXPECT_GE(p.fraction(), 0.0);
+      EXPECT_LE(p.fraction(), 1.0);
+      if (stages.empty() || stages.back() != p.stage) {
+        stages.push_back(p.stage);
+        EXPECT_EQ(p.done, 0u) << NO::streaming_stage_name(p.stage); // reported at its start
+      } else {
+        EXPECT_GE(p.done, log[i - 1].done) << NO::streaming_stage_name(p.stage);
+      }
+      if (i + 1 == log.size() || log[i + 1].stage != p.stage) { // and at its end
+        EXPECT_EQ(p.done, p.total) << NO::streaming_stage_name(p.stage);
+        EXPECT_EQ(p.fraction(), 1.0) << NO::streaming_stage_name(p.stage);
+      }
+    }
+    EXPECT_EQ(stages, expected);
+  };
+  check_log(std::vector<NO::Streaming_stage>(std::begin(order), std::end(order)));
+  std::size_t sweep_reports = 0;
+  for (const NO::Streaming_progress& p : log)
+    if (p.stage == NO::Streaming_stage::SWEEP) {
+      ++sweep_reports;
+      EXPECT_EQ(p.total, n);
+    }
+  EXPECT_GT(sweep_reports, 10u); // per batch
+  EXPECT_STREQ(NO::streaming_stage_name(NO::Streaming_stage::SWEEP), "sweep");
+  EXPECT_STREQ(NO::streaming_stage_name(NO::Streaming_stage::COMPONENTS), "components");
+
+  // presorted, with a radius and component files: no sort, no radius stage
+  log.clear();
+  {
+    NO::Streaming_options po = options;
+    po.presorted_axis = NO::Presorted_axis::X;
+    po.radius = 0.3;
+    po.component_files.directory = files.file("parts");
+    Vector_source source(sorted_by(cloud.records, 0));
+    stream(source, po, out);
+  }
+  check_log({NO::Streaming_stage::SCAN, NO::Streaming_stage::SWEEP, NO::Streaming_stage::SOLVE,
+             NO::Streaming_stage::SIGN, NO::Streaming_stage::OUTPUT, NO::Streaming_stage::COMPONENTS});
+
+  // cancelled half way through the sweep: Interrupted, nothing sunk, nothing left
+  {
+    NO::Streaming_options co = options;
+    co.callback = [](const NO::Streaming_progress& p) {
+      return !(p.stage == NO::Streaming_stage::SWEEP && p.fraction() >= 0.5);
+    };
+    Vector_source source(cloud.records);
+    EXPECT_THROW(stream(source, co, out), NO::Interrupted);
+    EXPECT_TRUE(out.empty());
+    EXPECT_EQ(directory.count(), 0u);
+  }
+  // cancelled during the sort
+  {
+    NO::Streaming_options co = options;
+    co.callback = [](const NO::Streaming_progress& p) {
+      return !(p.stage == NO::Streaming_stage::SORT && p.fraction() >= 0.5);
+    };
+    Vector_source source(cloud.records);
+    EXPECT_THROW(stream(source, co, out), NO::Interrupted);
+    EXPECT_EQ(directory.count(), 0u);
+  }
+  // cancelled once a component file is written: no output, no component
+  // file, not even the directory the run created, no temporary file
+  {
+    write_cloud(files.file("in.ply"), cloud.records);
+    NO::Streaming_options co = options;
+    co.radius = 0.3;
+    co.component_files.directory = files.file("cancelled");
+    co.component_files.maximum_open_files = 1;
+    bool seen_file = false;
+    co.callback = [&](const NO::Streaming_progress& p) {
+      seen_file = seen_file || fs::exists(files.file("cancelled/component_000000.ply"));
+      return !(p.stage == NO::Streaming_stage::COMPONENTS && seen_file);
+    };
+    EXPECT_THROW(NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), co), NO::Interrupted);
+    EXPECT_TRUE(seen_file);
+    EXPECT_EQ(files.listing(), (std::vector<std::string>{"in.ply", "parts"}));
+    EXPECT_EQ(directory.count(), 0u);
+  }
+}
+
+/// n points on a cylinder of radius 0.5 and length `length` along x, at a
+/// fixed density when n / length is fixed, in random order
+Test_cloud cylinder(std::size_t n, double length, std::mt19937_64& rng)
+{
+  std::uniform_real_distribution<double> along(0.0, length), angle(0.0, 2.0 * M_PI);
+  Test_cloud cloud;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = angle(rng);
+    cloud.add(Vec{{along(rng), 0.5 * std::cos(a), 0.5 * std::sin(a)}}, Vec{{0., std::cos(a), std::sin(a)}}, rng);
+  }
+  return cloud;
+}
+
+TEST(Streaming_window, PeakDoesNotGrowWithTheLength)
+{
+  Temporary_directory directory;
+  std::mt19937_64 rng(22);
+  const Test_cloud short_cloud = cylinder(20000, 25.0, rng), long_cloud = cylinder(80000, 100.0, rng);
+  for (const bool presorted : {true, false}) {
+    SCOPED_TRACE(presorted ? "presorted" : "sorted");
+    std::size_t peak[2] = {0, 0};
+    double radius[2] = {0, 0};
+    for (int which = 0; which < 2; ++which) {
+      const Test_cloud& cloud = which == 0 ? short_cloud : long_cloud;
+      Vector_source source(presorted ? sorted_by(cloud.records, 0) : cloud.records);
+      NO::Streaming_options options = streaming_options_in(directory.path());
+      options.batch_size = 1000; // the window is a slab of about 3r, plus a batch and a read
+      options.sort.memory_budget = 20000 * sizeof(ns::internal::Keyed_record);
+      if (presorted)
+        options.presorted_axis = NO::Presorted_axis::X;
+      std::vector<Point_record> out;
+      const NO::Streaming_result r = stream(source, options, out);
+      EXPECT_EQ(out.size(), cloud.records.size());
+      peak[which] = r.peak_window;
+      radius[which] = r.neighbor_radius;
+      std::cout << "[ info ] cylinder of " << cloud.records.size() << " points (" << (presorted ? "presorted" : "sorted")
+                << "): r = " << r.neighbor_radius << ", peak window " << r.peak_window << "\n";
+    }
+    EXPECT_NEAR(radius[1] / radius[0], 1.0, 0.1); // the same density
+    EXPECT_LE(double(peak[1]), 1.2 * double(peak[0]));
+    EXPECT_LT(peak[1], long_cloud.records.size() / 10);
+    EXPECT_LT(peak[0], short_cloud.records.size() / 2);
+  }
+  EXPECT_EQ(directory.count(), 0u);
 }
 
 } // namespace

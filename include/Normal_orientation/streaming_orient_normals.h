@@ -5,15 +5,18 @@
 
 /// \file streaming_orient_normals.h
 /// The out-of-core entry point (paper sec. 5): orients clouds larger than
-/// memory by sorting them along their principal axis, sweeping them with a
-/// window of bounded size, segmenting on the fly, solving the segment graph
-/// and re-streaming the points with their final signs.
+/// memory by sorting them along their principal axis (or reading them as
+/// they are when they are already sorted along x, y or z), sweeping them
+/// with a window of bounded size, segmenting on the fly, solving the
+/// segment graph and re-streaming the points with their final signs, to one
+/// output and, optionally, to one file per connected component.
 
 #include <Normal_orientation/Component_sign.h>
 #include <Normal_orientation/Flip_criteria.h>
 #include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/IO/Point_stream.h>
 #include <Normal_orientation/Orientation_problem.h>
+#include <Normal_orientation/internal/Progress.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
 #include <Normal_orientation/streaming/Point_record.h>
 #include <Normal_orientation/streaming/Record_file.h>
@@ -31,14 +34,116 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <filesystem>
 #include <functional>
+#include <memory>
+#include <numeric>
 #include <random>
+#include <sstream>
 #include <stdexcept>
 #include <string>
+#include <system_error>
 #include <utility>
 #include <vector>
 
 namespace Normal_orientation {
+
+/// \ingroup PkgNormalOrientationStreaming
+/// The coordinate along which a streamed input is already sorted (see
+/// `Streaming_options::presorted_axis`).
+enum class Presorted_axis
+{
+  NONE, ///< not sorted: the pipeline sorts it along its principal axis
+  X,    ///< sorted by non-decreasing x
+  Y,    ///< sorted by non-decreasing y
+  Z     ///< sorted by non-decreasing z
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// The stages of `streaming_orient_normals()`, in the order they run, as
+/// reported to `Streaming_options::callback`.
+enum class Streaming_stage
+{
+  SCAN,      ///< the first pass over the input: count, finiteness, frame, radius sample, order check
+  RADIUS,    ///< the k-nearest-neighbour distances of the radius sample (only when r is estimated)
+  SORT,      ///< the external sort along the principal axis (not with a presorted input)
+  SWEEP,     ///< the sweep: neighbour graph, edge weights, segmentation
+  SOLVE,     ///< the solver on the segment graph
+  SIGN,      ///< the outward sign of every component (passes over the record file)
+  OUTPUT,    ///< the oriented points handed to the sink
+  COMPONENTS ///< the files of the components (only with `Streaming_options::component_files`)
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// The lower-case name of `stage` ("scan", "radius", "sort", "sweep",
+/// "solve", "sign", "output", "components").
+inline const char* streaming_stage_name(Streaming_stage stage)
+{
+  switch (stage) {
+  case Streaming_stage::SCAN:
+    return "scan";
+  case Streaming_stage::RADIUS:
+    return "radius";
+  case Streaming_stage::SORT:
+    return "sort";
+  case Streaming_stage::SWEEP:
+    return "sweep";
+  case Streaming_stage::SOLVE:
+    return "solve";
+  case Streaming_stage::SIGN:
+    return "sign";
+  case Streaming_stage::OUTPUT:
+    return "output";
+  case Streaming_stage::COMPONENTS:
+    return "components";
+  }
+  return "?";
+}
+
+/// \ingroup PkgNormalOrientationStreaming
+/// What `Streaming_options::callback` is told: the stage running and how far
+/// it is.  Every stage is reported at its start (`done` = 0) and at its end
+/// (`done` = `total`), and in between as it goes (per chunk read, per batch
+/// of the sweep).
+struct Streaming_progress
+{
+  /// the stage running
+  Streaming_stage stage = Streaming_stage::SCAN;
+  /// the units of work of the stage done so far (points, or points times
+  /// passes; for `SOLVE`, 0 then 1)
+  std::uint64_t done = 0;
+  /// the units of work of the stage, 0 when unknown (the scan, which counts
+  /// the points)
+  std::uint64_t total = 0;
+  /// `done / total` in [0, 1]; 0 when the total is unknown
+  double fraction() const { return total > 0 ? std::min(1.0, double(done) / double(total)) : 0.0; }
+};
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Where and how `streaming_orient_normals()` writes one file per connected
+/// component (see `Streaming_options::component_files`).
+struct Component_files_options
+{
+  /// the directory of the files, created (with its parents) when missing;
+  /// empty: no component files
+  std::string directory;
+  /// the format of the files: ".ply", ".xyz" or ".pwn"; empty: ".ply" in
+  /// `streaming_orient_normals()`, the output's format (extension and write
+  /// options) in `streaming_orient_files()`
+  std::string extension;
+  /// how the files are written (binary or ascii PLY, normals)
+  IO::Point_stream_write_options write_options;
+  /// the most component files open at once (at least 1; each buffers
+  /// 1 MiB).  With more components than that, one pass over the record
+  /// file first splits it into one temporary file per group of that many
+  /// components, then each group is written from its file: the points are
+  /// read twice (and written once more) for up to `maximum_open_files`
+  /// squared components, with one more pass over the record file per
+  /// further `maximum_open_files` squared (the group files of one pass are
+  /// open together)
+  std::size_t maximum_open_files = 32;
+};
 
 /// \ingroup PkgNormalOrientationStreaming
 /// The parameters of `streaming_orient_normals()`.
@@ -58,27 +163,63 @@ struct Streaming_options
   streaming::External_sort_options sort;
   /// where the record file goes (empty: TMPDIR, else /tmp)
   std::string temporary_directory;
+  /// The input is already sorted by this coordinate (non-decreasing): the
+  /// principal axis and the external sort are skipped, the sweep reads the
+  /// source as it is, along that axis, and the output keeps the input
+  /// order.  The first pass still counts the points, checks that they are
+  /// finite and checks the order (`std::runtime_error` naming the first
+  /// point out of order, before any other work).  `Presorted_axis::NONE`
+  /// (the default): the input may be in any order.
+  Presorted_axis presorted_axis = Presorted_axis::NONE;
+  /// Components of fewer points are dropped: not handed to the sink, not
+  /// written to the component files, and counted in
+  /// `Streaming_result::number_of_dropped_points` and
+  /// `number_of_dropped_components`.  0 or 1: every point is kept.
+  std::uint64_t minimum_component_size = 0;
+  /// One file per kept connected component, written after the sink has
+  /// had every point: `component_000000.ply`, `component_000001.ply`, ...
+  /// (six digits or more, the extension of `Component_files_options`),
+  /// numbered by decreasing size (ties: in the sweep order of their first
+  /// point), each holding the points of its component in the sweep order,
+  /// with the same coordinates and normals as the sink gets.  Each file is
+  /// written to a temporary file and renamed when complete; files of the
+  /// same names are replaced, other files of the directory are left alone.
+  /// When the run fails or is cancelled, the component files it has
+  /// written are removed.  Not written when `directory` is empty.
+  Component_files_options component_files;
+  /// Progress and cancellation: called from the calling thread at the start
+  /// and the end of every stage and as it goes (per chunk read, per batch of
+  /// the sweep); returning `false` stops the run with `Interrupted`
+  /// (temporary files removed, nothing more handed to the sink, the
+  /// component files written so far removed).  Empty: no reports.
+  std::function<bool(const Streaming_progress&)> callback;
 };
 
 /// \ingroup PkgNormalOrientationStreaming
 /// What `streaming_orient_normals()` did.
 struct Streaming_result
 {
-  std::uint64_t number_of_points = 0;   ///< points oriented
+  std::uint64_t number_of_points = 0;   ///< points oriented (the dropped ones included)
   std::uint64_t number_of_edges = 0;    ///< edges of the (implicit) neighbour graph
   std::size_t number_of_segments = 0;   ///< segments, the vertices of the segment graph
   std::size_t number_of_segment_edges = 0; ///< edges of the segment graph
-  std::size_t number_of_components = 0; ///< connected components
+  std::size_t number_of_components = 0; ///< connected components (the dropped ones included)
+  std::size_t number_of_dropped_components = 0; ///< components below `Streaming_options::minimum_component_size`
+  std::uint64_t number_of_dropped_points = 0;   ///< their points, not handed to the sink
   std::size_t peak_window = 0;          ///< most points held by the sweep at once
   double neighbor_radius = 0.0;         ///< r used
   bool radius_estimated = false;        ///< r was estimated from a sample
+  bool presorted = false;               ///< the input was read as presorted (no principal axis, no sort)
   double segment_energy_before = 0.0;   ///< energy of the segment graph, preliminary orientation
   double segment_energy_after = 0.0;    ///< energy of the segment graph after the solver
-  std::uint64_t number_of_flipped = 0;  ///< normals whose sign changed
-  /// seconds per stage
+  std::uint64_t number_of_flipped = 0;  ///< normals handed to the sink whose sign changed
+  /// the component files written, by rank (largest component first)
+  std::vector<std::string> component_files;
+  /// seconds per stage (`frame`: the first pass over the input, whatever it
+  /// computes; `components`: the component files)
   struct Seconds
   {
-    double frame = 0, radius = 0, sort = 0, sweep = 0, solve = 0, sign = 0, output = 0, total = 0;
+    double frame = 0, radius = 0, sort = 0, sweep = 0, solve = 0, sign = 0, output = 0, components = 0, total = 0;
   } seconds;
 };
 
@@ -91,6 +232,14 @@ struct Swept_record
   streaming::Point_record record;
   std::uint32_t segment;
   std::int32_t flip;
+};
+
+/// a point with its final sign and the rank of its component, as kept in
+/// the temporary group files of the component output
+struct Ranked_record
+{
+  streaming::Point_record record;
+  std::uint64_t rank;
 };
 
 /// what the sweep keeps per point in its window
@@ -110,39 +259,173 @@ inline std::array<double, 3> unit_normal(const streaming::Point_record& r)
   return {r.normal[0] * inv, r.normal[1] * inv, r.normal[2] * inv};
 }
 
+/// Calls the user's progress callback, if any; throws `Interrupted` when it
+/// returns false.
+class Streaming_reporter
+{
+public:
+  explicit Streaming_reporter(const std::function<bool(const Streaming_progress&)>& callback)
+    : m_callback(callback)
+  {}
+  void operator()(Streaming_stage stage, std::uint64_t done, std::uint64_t total) const
+  {
+    if (!m_callback)
+      return;
+    Streaming_progress p;
+    p.stage = stage;
+    p.done = done;
+    p.total = total;
+    if (!m_callback(p))
+      throw Interrupted();
+  }
+
+private:
+  const std::function<bool(const Streaming_progress&)>& m_callback;
+};
+
+/// A source that reports, after every read, the number of records read so
+/// far (for the progress of the external sort).
+template <typename Source>
+class Reporting_source
+{
+public:
+  Reporting_source(Source& source, const Streaming_reporter& report, Streaming_stage stage, std::uint64_t total)
+    : m_source(source), m_report(report), m_stage(stage), m_total(total)
+  {}
+  std::size_t read(std::vector<streaming::Point_record>& chunk, std::size_t maximum)
+  {
+    const std::size_t got = m_source.read(chunk, maximum);
+    m_count += got;
+    m_report(m_stage, std::min(m_count, m_total), m_total);
+    return got;
+  }
+  void rewind()
+  {
+    m_source.rewind();
+    m_count = 0;
+  }
+
+private:
+  Source& m_source;
+  const Streaming_reporter& m_report;
+  Streaming_stage m_stage;
+  std::uint64_t m_total;
+  std::uint64_t m_count = 0;
+};
+
+/// The component files of one run: creates their directory, names them,
+/// and removes those written (and the directory, if it created it and it is
+/// empty) unless `keep()` was called.
+class Component_file_set
+{
+public:
+  explicit Component_file_set(const Component_files_options& options)
+    : m_directory(options.directory), m_extension(options.extension.empty() ? std::string(".ply") : options.extension)
+  {
+    if (m_directory.empty())
+      return;
+    const std::string e = IO::internal::lower_case_extension("f" + m_extension);
+    if (e != ".ply" && e != ".xyz" && e != ".pwn")
+      throw std::invalid_argument("streaming_orient_normals: unknown component file extension '" + m_extension +
+                                  "' (expected .ply, .xyz or .pwn)");
+    std::error_code ec;
+    if (std::filesystem::is_directory(m_directory, ec))
+      return;
+    if (std::filesystem::exists(m_directory, ec))
+      IO::internal::fail(m_directory, "cannot write the component files: not a directory");
+    m_created = std::filesystem::create_directories(m_directory, ec);
+    if (ec)
+      IO::internal::fail(m_directory, "cannot create the directory of the component files: " + ec.message());
+  }
+  Component_file_set(const Component_file_set&) = delete;
+  Component_file_set& operator=(const Component_file_set&) = delete;
+  ~Component_file_set()
+  {
+    if (m_kept)
+      return;
+    std::error_code ec;
+    for (const std::string& f : m_written)
+      std::filesystem::remove(f, ec);
+    if (m_created)
+      std::filesystem::remove(m_directory, ec); // only if empty
+  }
+  /// true when component files are wanted
+  bool enabled() const { return !m_directory.empty(); }
+  /// the name of the file of the component of rank `rank`
+  std::string path(std::size_t rank) const
+  {
+    char name[48];
+    std::snprintf(name, sizeof name, "component_%06zu", rank);
+    return (std::filesystem::path(m_directory) / (name + m_extension)).string();
+  }
+  /// records that the file `path` was written (committed)
+  void written(const std::string& path) { m_written.push_back(path); }
+  /// the files written, in order
+  const std::vector<std::string>& files() const { return m_written; }
+  /// the run succeeded: keep the files
+  void keep() { m_kept = true; }
+
+private:
+  std::string m_directory, m_extension;
+  std::vector<std::string> m_written;
+  bool m_created = false, m_kept = false;
+};
+
 } // namespace internal
 /// \endcond
 
 /// \ingroup PkgNormalOrientationStreaming
 /// Orients the points of `source` out of core and hands them to `sink`
-/// (`sink(const streaming::Point_record&)`, called once per point, in the
-/// sweep order, with the oriented normal: only its sign differs from the
+/// (`sink(const streaming::Point_record&)`, called once per point kept, in
+/// the sweep order, with the oriented normal: only its sign differs from the
 /// input's).
 ///
 /// `source` is a streaming source (`read(chunk, maximum)`, `rewind()`; see
-/// `external_sort.h`), read four times: the sweep frame, the radius sample,
-/// the external sort, then the sorted stream.  Stages:
-///  1. the centroid and principal axis (`compute_sweep_frame()`);
+/// `external_sort.h`), read twice: a first pass, then the external sort, or,
+/// with `Streaming_options::presorted_axis`, the sweep itself.  Stages:
+///  1. the first pass (`Streaming_stage::SCAN`): the number of points, the
+///     check that their coordinates are finite, the centroid and principal
+///     axis (`Sweep_frame`, as `compute_sweep_frame()` gives it; not with a
+///     presorted input, whose order is checked instead) and, when r is not
+///     given, a uniform sample of at most 200,000 points;
 ///  2. r, when not given: 4 x the 90th percentile of the k-th neighbour
-///     distance of a uniform sample of at most 200,000 points, scaled by
-///     sqrt(sample / n) (the spacing of a surface sample);
+///     distance of the sample, scaled by sqrt(sample / n) (the spacing of a
+///     surface sample);
 ///  3. the external sort along the axis (bounded memory, temporary files);
-///  4. the sweep (`streaming::sweep()`): each point meets its earlier
+///     skipped with a presorted input;
+///  4. the sweep (`streaming::sweep()`), along the axis or the presorted
+///     coordinate: each point meets its earlier
 ///     neighbours of the k-nearest-neighbour graph, gets its edge weights
 ///     w = phi * (1 - d^2 / r^2) (in parallel per batch, with the input
 ///     normals; the neighbours' preliminary flips multiply them, as labels
 ///     do in core) and is
 ///     segmented (`streaming::Segmenter`); points leaving the window
-///     go to a temporary record file;
+///     go to a temporary record file (the sort's files are removed then);
 ///  5. `solver` on the segment graph (a BGL graph);
 ///  6. the outward sign of every connected component, from two passes over
 ///     the record file (the rule of `Outward_component_sign`);
-///  7. the record file is re-streamed to `sink` with the final signs.
-/// Memory: the sweep window, the sort budget, and O(segments + segment
-/// pairs); the temporary files are removed on success and on exceptions.
+///  7. the record file is re-streamed to `sink` with the final signs,
+///     without the components smaller than
+///     `Streaming_options::minimum_component_size`;
+///  8. optionally, one file per kept component
+///     (`Streaming_options::component_files`).
 ///
-/// \throw std::invalid_argument for bad options; std::runtime_error and
-///        std::system_error from the source, the sort and the temporary files
+/// The neighbour graph does not depend on the sweep order: with the same
+/// r, a presorted input gives the same graph as the sorted path (up to ties
+/// in distance; r estimated from more than 200,000 points depends on the
+/// input order through the sample); the segmentation, made in the sweep
+/// order, may differ slightly.
+/// Memory: the sweep window, the sort budget, O(segments + segment pairs +
+/// components), and 1 MiB per open component file; the temporary files are
+/// removed on success, on exceptions and on cancellation.
+///
+/// \warning With `presorted_axis`, the input must be sorted by
+///          non-decreasing coordinate; the first pass checks it.
+/// \throw std::invalid_argument for bad options; std::runtime_error when a
+///        presorted input is not sorted (naming the point), and from the
+///        source, the sort and the temporary files (also std::system_error);
+///        `IO::Io_error` when a component file cannot be written;
+///        `Interrupted` when the callback returns false
 template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag,
           typename Kernel = CGAL::Exact_predicates_inexact_constructions_kernel, typename Source, typename Sink,
           typename FlipCriterion = Hoppe_criterion, typename Solver = Qpbo_i_solver>
@@ -161,15 +444,74 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   if (options.radius != 0.0 && !(options.radius > 0.0 && std::isfinite(options.radius)))
     throw std::invalid_argument("streaming_orient_normals: the radius must be a finite number > 0");
   const unsigned int k = options.number_of_neighbors;
+  const bool presorted = options.presorted_axis != Presorted_axis::NONE;
+  const int axis = options.presorted_axis == Presorted_axis::Y ? 1 : options.presorted_axis == Presorted_axis::Z ? 2 : 0;
+  result.presorted = presorted;
+  const internal::Streaming_reporter report(options.callback);
+  internal::Component_file_set component_files(options.component_files); // checks and creates the directory
 
-  // 1. Frame.
+  // 1. The first pass: count, finiteness, frame (or order), radius sample.
   auto t = Clock::now();
-  const streaming::Sweep_frame frame = streaming::compute_sweep_frame(source);
+  report(Streaming_stage::SCAN, 0, 0);
+  const bool estimate_radius = options.radius == 0.0;
+  std::vector<Point> sample;
+  std::uint64_t n = 0, non_finite = 0;
+  streaming::Sweep_frame frame;
+  {
+    streaming::internal::Moment_accumulator moments;
+    const std::size_t m = 200000;
+    std::mt19937_64 rng(0x5eed);
+    std::vector<streaming::Point_record> chunk;
+    chunk.reserve(65536);
+    double last = -HUGE_VAL;
+    source.rewind();
+    while (true) { // reservoir sampling, deterministic
+      chunk.clear();
+      if (source.read(chunk, 65536) == 0)
+        break;
+      for (const streaming::Point_record& r : chunk) {
+        const bool finite = std::isfinite(r.position[0]) && std::isfinite(r.position[1]) && std::isfinite(r.position[2]);
+        if (!finite)
+          ++non_finite;
+        if (presorted) {
+          if (finite) {
+            const double v = r.position[axis];
+            if (v < last) {
+              std::ostringstream msg;
+              msg.precision(17);
+              msg << "streaming_orient_normals: the input is not sorted by increasing " << char('x' + axis)
+                  << " (presorted_axis): point " << n << " (input index " << r.index << ") has " << char('x' + axis)
+                  << " = " << v << ", below the previous point's " << last;
+              throw std::runtime_error(msg.str());
+            }
+            last = v;
+          }
+        } else
+          moments.add(r);
+        if (estimate_radius) {
+          const Point p(r.position[0], r.position[1], r.position[2]);
+          if (sample.size() < m)
+            sample.push_back(p);
+          else {
+            const std::uint64_t j = rng() % (n + 1);
+            if (j < m)
+              sample[std::size_t(j)] = p;
+          }
+        }
+        ++n;
+      }
+      report(Streaming_stage::SCAN, n, 0);
+    }
+    source.rewind();
+    if (!presorted)
+      frame = moments.frame();
+  }
+  report(Streaming_stage::SCAN, n, n);
   result.seconds.frame = since(t);
-  const std::uint64_t n = frame.size;
-  if (frame.non_finite > 0)
+  if (non_finite > 0)
     throw std::runtime_error("streaming_orient_normals: the input has points with non-finite coordinates");
   if (n == 0) {
+    component_files.keep();
     result.seconds.total = since(t_start);
     return result;
   }
@@ -177,31 +519,8 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   // 2. Radius.
   t = Clock::now();
   double radius = options.radius;
-  if (radius == 0.0) {
-    const std::size_t m = std::size_t(std::min<std::uint64_t>(n, 200000));
-    std::vector<Point> sample;
-    sample.reserve(m);
-    std::mt19937_64 rng(0x5eed);
-    std::vector<streaming::Point_record> chunk;
-    std::uint64_t seen = 0;
-    source.rewind();
-    while (true) { // reservoir sampling, deterministic
-      chunk.clear();
-      if (source.read(chunk, 65536) == 0)
-        break;
-      for (const auto& r : chunk) {
-        const Point p(r.position[0], r.position[1], r.position[2]);
-        if (sample.size() < m)
-          sample.push_back(p);
-        else {
-          const std::uint64_t j = rng() % (seen + 1);
-          if (j < m)
-            sample[std::size_t(j)] = p;
-        }
-        ++seen;
-      }
-    }
-    source.rewind();
+  if (estimate_radius) {
+    report(Streaming_stage::RADIUS, 0, 1);
     const unsigned int ks = unsigned(std::min<std::size_t>(k, sample.size() > 1 ? sample.size() - 1 : 0));
     if (ks > 0) {
       std::vector<std::uint32_t> nb;
@@ -218,17 +537,26 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     if (!(radius > 0.0) || !std::isfinite(radius))
       radius = 1.0;
     result.radius_estimated = true;
+    std::vector<Point>().swap(sample);
+    report(Streaming_stage::RADIUS, 1, 1);
   }
   result.neighbor_radius = radius;
   result.seconds.radius = since(t);
 
-  // 3. Sort.
+  // 3. Sort (unless presorted).
   t = Clock::now();
-  streaming::Sorted_run_reader sorted = streaming::external_sort(source, frame, options.sort);
-  result.seconds.sort = since(t);
+  streaming::Sorted_run_reader sorted;
+  if (!presorted) {
+    report(Streaming_stage::SORT, 0, n);
+    internal::Reporting_source<Source> counted(source, report, Streaming_stage::SORT, n);
+    sorted = streaming::external_sort(counted, frame, options.sort);
+    report(Streaming_stage::SORT, n, n);
+    result.seconds.sort = since(t);
+  }
 
   // 4. Sweep and segmentation.
   t = Clock::now();
+  report(Streaming_stage::SWEEP, 0, n);
   streaming::Record_file<internal::Swept_record> records(options.temporary_directory);
   streaming::Segmenter segmenter(options.thresholds);
   std::vector<std::uint64_t> segment_size;
@@ -240,6 +568,8 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     streaming::Record_file<internal::Swept_record>& records;
     std::vector<std::uint64_t>& segment_size;
     double r2;
+    const internal::Streaming_reporter& report;
+    std::uint64_t n;
     std::vector<streaming::Neighbor_vote> votes;
 
     // The edge weights of a whole batch, in parallel, with the input
@@ -250,6 +580,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     void prepare(streaming::Sweep_window<internal::Sweep_payload>& w, std::uint64_t first,
                  const std::vector<std::size_t>& offsets, const std::vector<streaming::Sweep_neighbor>& neighbors)
     {
+      report(Streaming_stage::SWEEP, first, n); // `first` points are finalised
       weights.resize(neighbors.size());
       cursor = 0;
       internal::parallel_chunks<ConcurrencyTag>(offsets.size() - 1, [&](std::size_t b, std::size_t e) {
@@ -287,22 +618,30 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     {
       records.append(internal::Swept_record{w.record(s), w.payload(s).segment, std::int32_t(w.payload(s).flip)});
     }
-  } visitor{criterion, segmenter, records, segment_size, r2, {}, {}, 0};
+  } visitor{criterion, segmenter, records, segment_size, r2, report, n, {}, {}, 0};
   streaming::Sweep_window<internal::Sweep_payload> window;
   streaming::Sweep_options so;
   so.number_of_neighbors = k;
   so.radius = radius;
   so.batch_size = options.batch_size;
-  const streaming::Sweep_report sr = streaming::sweep<ConcurrencyTag, Kernel>(
-    sorted, [&frame](const streaming::Point_record& r) { return frame.key(r); }, so, visitor, window);
+  const streaming::Sweep_report sr =
+    presorted ? streaming::sweep<ConcurrencyTag, Kernel>(
+                  source, [axis](const streaming::Point_record& r) { return r.position[axis]; }, so, visitor, window)
+              : streaming::sweep<ConcurrencyTag, Kernel>(
+                  sorted, [&frame](const streaming::Point_record& r) { return frame.key(r); }, so, visitor, window);
+  sorted = streaming::Sorted_run_reader(); // removes the sort's files
+  if (presorted)
+    source.rewind();
   records.rewind();
   result.number_of_points = sr.number_of_points;
   result.number_of_edges = sr.number_of_edges;
   result.peak_window = sr.peak_window;
+  report(Streaming_stage::SWEEP, n, n);
   result.seconds.sweep = since(t);
 
   // 5. The segment graph and its solution.
   t = Clock::now();
+  report(Streaming_stage::SOLVE, 0, 1);
   const std::size_t ns = segmenter.number_of_segments();
   result.number_of_segments = ns;
   const auto& pairs = segmenter.segment_pairs();
@@ -324,6 +663,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   std::vector<std::uint32_t> component;
   const std::size_t nc = connected_components(sg, weight, component);
   result.number_of_components = nc;
+  report(Streaming_stage::SOLVE, 1, 1);
   result.seconds.solve = since(t);
 
   // 6. Outward sign per component (the rule of Outward_component_sign, in
@@ -356,13 +696,17 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     const double f = double(s.flip) * double(x[s.segment]);
     return std::array<double, 3>{f * u[0], f * u[1], f * u[2]};
   };
-  for (int pass = 0; pass < (any_large ? 2 : 1); ++pass) {
+  const int sign_passes = any_large ? 2 : 1;
+  report(Streaming_stage::SIGN, 0, std::uint64_t(sign_passes) * n);
+  for (int pass = 0; pass < sign_passes; ++pass) {
     std::fill(seen.begin(), seen.end(), 0);
     records.rewind();
+    std::uint64_t read = 0;
     while (true) {
       buffer.clear();
       if (records.read(buffer, 1 << 15) == 0)
         break;
+      read += buffer.size();
       for (const internal::Swept_record& s : buffer) {
         const std::uint32_t c = component[s.segment];
         const double* p = s.record.position;
@@ -396,6 +740,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
           }
         }
       }
+      report(Streaming_stage::SIGN, std::uint64_t(pass) * n + read, std::uint64_t(sign_passes) * n);
     }
   }
   std::vector<char> flip_component(nc, 0);
@@ -416,25 +761,156 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   }
   result.seconds.sign = since(t);
 
+  // The components kept, ranked by decreasing size (ties: by component
+  // number, the sweep order of their first segment).
+  const std::uint64_t minimum = options.minimum_component_size;
+  constexpr std::uint64_t dropped = ~std::uint64_t(0);
+  std::vector<std::uint64_t> rank(nc, dropped);
+  std::size_t kept = 0;
+  std::uint64_t kept_points = 0;
+  {
+    std::vector<std::uint32_t> order;
+    for (std::size_t c = 0; c < nc; ++c)
+      if (size[c] > 0 && size[c] >= minimum)
+        order.push_back(std::uint32_t(c));
+      else if (size[c] > 0) {
+        ++result.number_of_dropped_components;
+        result.number_of_dropped_points += size[c];
+      }
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return size[a] > size[b]; });
+    for (std::size_t i = 0; i < order.size(); ++i) {
+      rank[order[i]] = i;
+      kept_points += size[order[i]];
+    }
+    kept = order.size();
+  }
+  // the final record of a swept point; true when its normal was turned
+  auto finish = [&](const internal::Swept_record& s, streaming::Point_record& out) {
+    out = s.record;
+    const int label = s.flip * int(x[s.segment]) * (flip_component[component[s.segment]] ? -1 : 1);
+    if (label >= 0)
+      return false;
+    for (double& v : out.normal)
+      v = -v;
+    return out.normal[0] != 0.0 || out.normal[1] != 0.0 || out.normal[2] != 0.0;
+  };
+
   // 7. Output.
   t = Clock::now();
+  report(Streaming_stage::OUTPUT, 0, n);
   records.rewind();
-  while (true) {
-    buffer.clear();
-    if (records.read(buffer, 1 << 15) == 0)
-      break;
-    for (internal::Swept_record& s : buffer) {
-      const int label = s.flip * int(x[s.segment]) * (flip_component[component[s.segment]] ? -1 : 1);
-      if (label < 0) {
-        for (double& v : s.record.normal)
-          v = -v;
-        if (s.record.normal[0] != 0.0 || s.record.normal[1] != 0.0 || s.record.normal[2] != 0.0)
+  {
+    std::uint64_t read = 0;
+    streaming::Point_record out;
+    while (true) {
+      buffer.clear();
+      if (records.read(buffer, 1 << 15) == 0)
+        break;
+      read += buffer.size();
+      for (const internal::Swept_record& s : buffer) {
+        if (rank[component[s.segment]] == dropped)
+          continue;
+        if (finish(s, out))
           ++result.number_of_flipped;
+        sink(out);
       }
-      sink(s.record);
+      report(Streaming_stage::OUTPUT, read, n);
     }
   }
   result.seconds.output = since(t);
+
+  // 8. One file per kept component, at most G open at once.
+  if (component_files.enabled() && kept > 0) {
+    t = Clock::now();
+    const std::size_t G = std::max<std::size_t>(1, options.component_files.maximum_open_files);
+    const std::size_t groups = (kept + G - 1) / G;
+    const std::size_t rounds = (groups + G - 1) / G;
+    const std::uint64_t total = groups == 1 ? n : std::uint64_t(rounds) * n + kept_points;
+    std::uint64_t done = 0;
+    report(Streaming_stage::COMPONENTS, 0, total);
+    std::vector<IO::Point_stream_writer> writers;
+    auto open_writers = [&](std::size_t first, std::size_t last) {
+      writers.clear();
+      writers.reserve(last - first);
+      for (std::size_t r = first; r < last; ++r)
+        writers.emplace_back(component_files.path(r), options.component_files.write_options);
+    };
+    auto commit_writers = [&]() {
+      for (IO::Point_stream_writer& w : writers) {
+        w.commit();
+        component_files.written(w.filename());
+      }
+      writers.clear();
+    };
+    streaming::Point_record out;
+    if (groups == 1) {
+      open_writers(0, kept);
+      records.rewind();
+      while (true) {
+        buffer.clear();
+        if (records.read(buffer, 1 << 15) == 0)
+          break;
+        done += buffer.size();
+        for (const internal::Swept_record& s : buffer) {
+          const std::uint64_t r = rank[component[s.segment]];
+          if (r == dropped)
+            continue;
+          finish(s, out);
+          writers[std::size_t(r)].write(out);
+        }
+        report(Streaming_stage::COMPONENTS, done, total);
+      }
+      commit_writers();
+    } else {
+      std::vector<internal::Ranked_record> ranked;
+      for (std::size_t round = 0; round < rounds; ++round) {
+        // split the records of the groups of this round into one file per group
+        const std::size_t first_group = round * G, last_group = std::min(groups, first_group + G);
+        const std::uint64_t first_rank = std::uint64_t(first_group) * G,
+                            last_rank = std::min<std::uint64_t>(kept, std::uint64_t(last_group) * G);
+        std::vector<std::unique_ptr<streaming::Record_file<internal::Ranked_record>>> group_files;
+        for (std::size_t g = first_group; g < last_group; ++g)
+          group_files.push_back(
+            std::make_unique<streaming::Record_file<internal::Ranked_record>>(options.temporary_directory, 4096));
+        records.rewind();
+        while (true) {
+          buffer.clear();
+          if (records.read(buffer, 1 << 15) == 0)
+            break;
+          done += buffer.size();
+          for (const internal::Swept_record& s : buffer) {
+            const std::uint64_t r = rank[component[s.segment]];
+            if (r == dropped || r < first_rank || r >= last_rank)
+              continue;
+            finish(s, out);
+            group_files[std::size_t(r / G) - first_group]->append(internal::Ranked_record{out, r});
+          }
+          report(Streaming_stage::COMPONENTS, done, total);
+        }
+        // then write each group, one file per component
+        for (std::size_t g = first_group; g < last_group; ++g) {
+          streaming::Record_file<internal::Ranked_record>& file = *group_files[g - first_group];
+          open_writers(g * G, std::min(kept, (g + 1) * G));
+          file.rewind();
+          while (true) {
+            ranked.clear();
+            if (file.read(ranked, 1 << 14) == 0)
+              break;
+            done += ranked.size();
+            for (const internal::Ranked_record& rr : ranked)
+              writers[std::size_t(rr.rank - std::uint64_t(g) * G)].write(rr.record);
+            report(Streaming_stage::COMPONENTS, done, total);
+          }
+          commit_writers();
+          group_files[g - first_group].reset(); // removes the group file
+        }
+      }
+    }
+    report(Streaming_stage::COMPONENTS, total, total);
+    result.seconds.components = since(t);
+  }
+  result.component_files = component_files.files();
+  component_files.keep();
   result.seconds.total = since(t_start);
   return result;
 }
@@ -445,9 +921,15 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
 /// `streaming_orient_normals()` and writes it to `output` (.xyz, .pwn or
 /// .ply by extension; binary PLY unless `write_options.binary` is false).
 /// The output holds the points in the sweep order (along the principal
-/// axis), with their input coordinates and normals whose sign only may
-/// have changed.  It is written to a temporary file renamed at the end: on
-/// any error no output file exists.
+/// axis; with `Streaming_options::presorted_axis`, the input order), with
+/// their input coordinates and normals whose sign only may have changed,
+/// without the components smaller than
+/// `Streaming_options::minimum_component_size`.  It is written to a
+/// temporary file renamed at the end: on any error no output file exists.
+/// With `Streaming_options::component_files` (a directory), one file per
+/// kept component is written there too, by default in the output's format
+/// (see `Component_files_options::extension`); they are removed when the
+/// run fails, the output's last step included.
 /// \throw IO::Io_error for unreadable, malformed or unwritable files, or an
 ///        input without normals; see `streaming_orient_normals()`
 template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag,
@@ -464,11 +946,23 @@ Streaming_result streaming_orient_files(const std::string& input, const std::str
   if (!reader.has_normals())
     throw IO::Io_error(input + ": the file has no normals (streaming needs them)");
   IO::Point_stream_writer writer(output, write_options);
+  Streaming_options o = options;
+  if (!o.component_files.directory.empty() && o.component_files.extension.empty()) {
+    o.component_files.extension = std::filesystem::path(output).extension().string();
+    o.component_files.write_options = write_options;
+  }
   auto sink = [&writer](const streaming::Point_record& r) { writer.write(r); };
   Streaming_result result =
-    streaming_orient_normals<ConcurrencyTag, Kernel>(reader, sink, options, criterion, solver);
+    streaming_orient_normals<ConcurrencyTag, Kernel>(reader, sink, o, criterion, solver);
   const auto t = std::chrono::steady_clock::now();
-  writer.commit();
+  try {
+    writer.commit();
+  } catch (...) {
+    std::error_code ec;
+    for (const std::string& f : result.component_files)
+      std::filesystem::remove(f, ec);
+    throw;
+  }
   result.seconds.output += std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   return result;
 }
