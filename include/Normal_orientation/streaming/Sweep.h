@@ -23,6 +23,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <mutex>
+#include <thread>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -116,6 +120,91 @@ private:
 
 /// \cond SKIP_IN_MANUAL
 namespace internal {
+/// Reads a streaming source on a thread of its own, a few chunks ahead of
+/// the consumer, so that the reading (parsing, merging sorted runs) runs
+/// while the sweep computes.  The chunks arrive in the source's order; an
+/// exception thrown by the source is rethrown by `read()`; the destructor
+/// stops and joins the thread.
+template <typename Source>
+class Prefetcher
+{
+public:
+  Prefetcher(Source& source, std::size_t chunk_size, std::size_t depth = 3)
+    : m_source(source), m_chunk_size(chunk_size), m_depth(std::max<std::size_t>(1, depth))
+  {
+    m_thread = std::thread([this] { run(); });
+  }
+  Prefetcher(const Prefetcher&) = delete;
+  Prefetcher& operator=(const Prefetcher&) = delete;
+  ~Prefetcher()
+  {
+    {
+      std::lock_guard<std::mutex> lock(m_mutex);
+      m_stop = true;
+    }
+    m_changed.notify_all();
+    m_thread.join();
+  }
+  /// appends the next chunk to `chunk`; returns its size, 0 at the end
+  std::size_t read(std::vector<Point_record>& chunk)
+  {
+    std::unique_lock<std::mutex> lock(m_mutex);
+    m_changed.wait(lock, [this] { return !m_ready.empty() || m_done; });
+    if (m_ready.empty()) {
+      if (m_error)
+        std::rethrow_exception(m_error);
+      return 0;
+    }
+    std::vector<Point_record> next = std::move(m_ready.front());
+    m_ready.pop_front();
+    lock.unlock();
+    m_changed.notify_all();
+    const std::size_t got = next.size();
+    if (chunk.empty())
+      chunk.swap(next);
+    else
+      chunk.insert(chunk.end(), next.begin(), next.end());
+    return got;
+  }
+
+private:
+  void run()
+  {
+    try {
+      while (true) {
+        std::vector<Point_record> chunk;
+        chunk.reserve(m_chunk_size);
+        const std::size_t got = m_source.read(chunk, m_chunk_size);
+        std::unique_lock<std::mutex> lock(m_mutex);
+        if (got == 0 || m_stop)
+          break;
+        m_ready.push_back(std::move(chunk));
+        m_changed.notify_all();
+        m_changed.wait(lock, [this] { return m_ready.size() < m_depth || m_stop; });
+        if (m_stop)
+          break;
+      }
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(m_mutex);
+      m_error = std::current_exception();
+    }
+    {
+      std::lock_guard<std::mutex> lock(m_mutex);
+      m_done = true;
+    }
+    m_changed.notify_all();
+  }
+
+  Source& m_source;
+  std::size_t m_chunk_size, m_depth;
+  std::mutex m_mutex;
+  std::condition_variable m_changed;
+  std::deque<std::vector<Point_record>> m_ready;
+  bool m_done = false, m_stop = false;
+  std::exception_ptr m_error;
+  std::thread m_thread;
+};
+
 /// true when `Visitor` has `prepare(window, first, offsets, neighbors)`
 template <typename Visitor, typename Window, typename = void>
 struct Has_prepare : std::false_type
@@ -188,6 +277,7 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
   const std::size_t read_size = std::max<std::size_t>(64, std::min<std::size_t>(batch, 65536));
 
   Sweep_report report;
+  internal::Prefetcher<Source> prefetcher(source, read_size);
   auto& slots = window.m_slots;
   std::uint64_t finalized = window.m_base + slots.size(); // the next point to finalise
   std::uint64_t read_count = 0;
@@ -204,8 +294,12 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
   std::vector<Reverse> reverse, bucketed;
   std::vector<std::size_t> batch_first;
   std::vector<Sweep_neighbor> batch_neighbors;
-  std::vector<std::size_t> bucket_start;
+  std::vector<std::size_t> bucket_start, bucket_begin, upper;
+  std::vector<Sweep_neighbor> scratch;
   std::vector<Point> points;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed; // (Morton code, slot), sorted
+  std::vector<std::uint32_t> queries;                          // tree positions of the batch
+  std::vector<double> part_box;
   std::vector<std::uint32_t> knn;
   std::vector<float> knn_d2;
   std::vector<Sweep_neighbor> earlier;
@@ -223,7 +317,7 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
     std::uint64_t ready = finalizable();
     while (!at_end && ready - finalized < batch) {
       chunk.clear();
-      const std::size_t got = source.read(chunk, read_size);
+      const std::size_t got = prefetcher.read(chunk);
       if (got == 0) {
         at_end = true;
         break;
@@ -250,25 +344,79 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
       continue;
     }
 
-    // 2. kNN of the points [finalized, ready) over the window.
+    // 2. kNN of the points [finalized, ready) over the window.  The tree is
+    //    built over the window's points in Morton order, and the batch is
+    //    queried in that order: consecutive queries then visit the same
+    //    leaves, several times faster than in the sweep order, whose
+    //    consecutive points lie far apart across the slab.
     const auto t0 = std::chrono::steady_clock::now();
     const std::size_t w = slots.size();
+    const std::size_t first_slot = std::size_t(finalized - window.m_base);
+    const std::size_t count = std::size_t(ready - finalized);
+    {
+      // the bounding box, in a fixed number of parts (deterministic)
+      const std::size_t parts = 64;
+      part_box.assign(parts * 6, 0.0);
+      Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(parts, [&](std::size_t pb, std::size_t pe) {
+        for (std::size_t part = pb; part < pe; ++part) {
+          double* box = &part_box[part * 6];
+          for (int d = 0; d < 3; ++d) {
+            box[d] = HUGE_VAL;
+            box[3 + d] = -HUGE_VAL;
+          }
+          for (std::size_t s = w * part / parts; s < w * (part + 1) / parts; ++s)
+            for (int d = 0; d < 3; ++d) {
+              box[d] = std::min(box[d], slots[s].record.position[d]);
+              box[3 + d] = std::max(box[3 + d], slots[s].record.position[d]);
+            }
+        }
+      }, 1);
+      double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+      for (std::size_t part = 0; part < parts; ++part)
+        for (int d = 0; d < 3; ++d) {
+          lo[d] = std::min(lo[d], part_box[part * 6 + d]);
+          hi[d] = std::max(hi[d], part_box[part * 6 + 3 + d]);
+        }
+      const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+      const double scale = extent > 0.0 ? double((1u << 21) - 1) / extent : 0.0;
+      keyed.resize(w);
+      Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(w, [&](std::size_t b, std::size_t e) {
+        for (std::size_t s = b; s < e; ++s) {
+          const double* p = slots[s].record.position;
+          std::uint64_t code = 0;
+          for (int d = 0; d < 3; ++d)
+            code |= Normal_orientation::internal::spread_bits_3(std::uint64_t((p[d] - lo[d]) * scale)) << d;
+          keyed[s] = {code, std::uint32_t(s)};
+        }
+      });
+      Normal_orientation::internal::parallel_sort<ConcurrencyTag>(keyed, std::less<std::pair<std::uint64_t, std::uint32_t>>());
+    }
     points.resize(w);
-    for (std::size_t s = 0; s < w; ++s)
-      points[s] = Point(slots[s].record.position[0], slots[s].record.position[1], slots[s].record.position[2]);
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(w, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const double* p = slots[keyed[i].second].record.position;
+        points[i] = Point(p[0], p[1], p[2]);
+      }
+    });
+    queries.clear();
+    for (std::size_t i = 0; i < w; ++i)
+      if (keyed[i].second >= first_slot && keyed[i].second - first_slot < count)
+        queries.push_back(std::uint32_t(i));
     const Point_pmap pmap = CGAL::make_property_map(static_cast<const std::vector<Point>&>(points));
     Tree tree(boost::counting_iterator<std::uint32_t>(0), boost::counting_iterator<std::uint32_t>(std::uint32_t(w)),
               typename Types::Splitter(), typename Types::Traits(pmap));
     tree.template build<ConcurrencyTag>();
     const Distance distance(pmap);
-    const std::size_t first_slot = std::size_t(finalized - window.m_base);
-    const std::size_t count = std::size_t(ready - finalized);
     knn.assign(count * k, ~std::uint32_t(0));
     knn_d2.assign(count * k, 0.f);
-    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(queries.size(), [&](std::size_t b, std::size_t e) {
+      std::vector<std::uint32_t> nb(k);
       for (std::size_t q = b; q < e; ++q) {
-        const std::uint32_t i = std::uint32_t(first_slot + q);
-        Types::nearest(tree, distance, points[i], i, k, &knn[q * k], &knn_d2[q * k]);
+        const std::uint32_t i = queries[q];
+        const std::size_t row = std::size_t(keyed[i].second - first_slot) * k;
+        const unsigned int found = Types::nearest(tree, distance, points[i], i, k, nb.data(), &knn_d2[row]);
+        for (unsigned int t = 0; t < found; ++t)
+          knn[row + t] = keyed[nb[t]].second; // tree position -> slot
       }
     }, 256);
     report.seconds_neighbors += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -294,6 +442,7 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
         ++bucket_start[std::size_t(e.target - finalized) + 1];
       for (std::size_t b = 0; b < span; ++b)
         bucket_start[b + 1] += bucket_start[b];
+      bucket_begin.assign(bucket_start.begin(), bucket_start.begin() + std::ptrdiff_t(std::min(span, count) + 1));
       bucketed.resize(reverse.size());
       for (const Reverse& e : reverse)
         bucketed[bucket_start[std::size_t(e.target - finalized)]++] = e;
@@ -303,34 +452,47 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
     // 4. The earlier neighbours of every point of the batch (sorted by
     //    sequence number), then the visitor: `prepare` on the whole batch
     //    when it has one (it may work in parallel), then `finalize` in order.
-    std::size_t rv = 0;
-    batch_first.assign(1, 0);
-    batch_neighbors.clear();
-    for (std::size_t q = 0; q < count; ++q) {
-      const std::uint64_t sp = finalized + q;
-      const std::size_t begin = batch_neighbors.size();
-      for (unsigned int t = 0; t < k; ++t) {
-        const std::uint32_t j = knn[q * k + t];
-        if (j == ~std::uint32_t(0) || !(double(knn_d2[q * k + t]) < r2))
-          continue;
-        const std::uint64_t sj = window.m_base + j;
-        if (sj < sp)
-          batch_neighbors.push_back({sj, knn_d2[q * k + t]});
+    //    Point q's list: its own earlier kNN, then the reverse edges of
+    //    bucket q, sorted and without duplicates; built in parallel into
+    //    slots of the upper-bound size, then compacted.
+    const std::size_t rv = bucket_begin[count]; // the reverse edges of later points start here
+    upper.resize(count + 1);
+    upper[0] = 0;
+    for (std::size_t q = 0; q < count; ++q)
+      upper[q + 1] = upper[q] + k + (bucket_begin[q + 1] - bucket_begin[q]);
+    scratch.resize(upper[count]);
+    batch_first.resize(count + 1);
+    batch_first[0] = 0;
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
+      for (std::size_t q = b; q < e; ++q) {
+        const std::uint64_t sp = finalized + q;
+        Sweep_neighbor* const first = scratch.data() + upper[q];
+        Sweep_neighbor* last = first;
+        for (unsigned int t = 0; t < k; ++t) {
+          const std::uint32_t j = knn[q * k + t];
+          if (j == ~std::uint32_t(0) || !(double(knn_d2[q * k + t]) < r2))
+            continue;
+          const std::uint64_t sj = window.m_base + j;
+          if (sj < sp)
+            *last++ = Sweep_neighbor{sj, knn_d2[q * k + t]};
+        }
+        for (std::size_t v = bucket_begin[q]; v < bucket_begin[q + 1]; ++v)
+          *last++ = Sweep_neighbor{reverse[v].source, reverse[v].squared_distance};
+        std::sort(first, last, [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence < c.sequence; });
+        last = std::unique(first, last,
+                           [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence == c.sequence; });
+        batch_first[q + 1] = std::size_t(last - first); // the count, for now
       }
-      while (rv < reverse.size() && reverse[rv].target == sp) {
-        batch_neighbors.push_back({reverse[rv].source, reverse[rv].squared_distance});
-        ++rv;
-      }
-      auto first = batch_neighbors.begin() + std::ptrdiff_t(begin);
-      std::sort(first, batch_neighbors.end(),
-                [](const Sweep_neighbor& a, const Sweep_neighbor& b) { return a.sequence < b.sequence; });
-      batch_neighbors.erase(std::unique(first, batch_neighbors.end(),
-                                        [](const Sweep_neighbor& a, const Sweep_neighbor& b) {
-                                          return a.sequence == b.sequence;
-                                        }),
-                            batch_neighbors.end());
-      batch_first.push_back(batch_neighbors.size());
-    }
+    }, 1024);
+    for (std::size_t q = 0; q < count; ++q)
+      batch_first[q + 1] += batch_first[q];
+    batch_neighbors.resize(batch_first[count]);
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
+      for (std::size_t q = b; q < e; ++q)
+        std::copy(scratch.begin() + std::ptrdiff_t(upper[q]),
+                  scratch.begin() + std::ptrdiff_t(upper[q] + batch_first[q + 1] - batch_first[q]),
+                  batch_neighbors.begin() + std::ptrdiff_t(batch_first[q]));
+    }, 4096);
     report.number_of_edges += batch_neighbors.size();
     if constexpr (internal::Has_prepare<Visitor, Sweep_window<Payload>>::value)
       visitor.prepare(window, finalized, batch_first, batch_neighbors);
