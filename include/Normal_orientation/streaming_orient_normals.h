@@ -523,6 +523,13 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     report(Streaming_stage::RADIUS, 0, 1);
     const unsigned int ks = unsigned(std::min<std::size_t>(k, sample.size() > 1 ? sample.size() - 1 : 0));
     if (ks > 0) {
+      { // queries in Morton order are several times faster (the quantile does not depend on the order)
+        const std::vector<std::uint32_t> order = internal::morton_order<ConcurrencyTag>(sample);
+        std::vector<Point> sorted(sample.size());
+        for (std::size_t i = 0; i < order.size(); ++i)
+          sorted[i] = sample[order[i]];
+        sample.swap(sorted);
+      }
       std::vector<std::uint32_t> nb;
       std::vector<float> d2;
       internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(sample, ks, nb, d2,

@@ -294,8 +294,7 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
   std::vector<Reverse> reverse, bucketed;
   std::vector<std::size_t> batch_first;
   std::vector<Sweep_neighbor> batch_neighbors;
-  std::vector<std::size_t> bucket_start, bucket_begin, upper;
-  std::vector<Sweep_neighbor> scratch;
+  std::vector<std::size_t> bucket_start, bucket_begin;
   std::vector<Point> points;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed; // (Morton code, slot), sorted
   std::vector<std::uint32_t> queries;                          // tree positions of the batch
@@ -453,46 +452,48 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
     //    sequence number), then the visitor: `prepare` on the whole batch
     //    when it has one (it may work in parallel), then `finalize` in order.
     //    Point q's list: its own earlier kNN, then the reverse edges of
-    //    bucket q, sorted and without duplicates; built in parallel into
-    //    slots of the upper-bound size, then compacted.
+    //    bucket q, sorted and without duplicates; built in parallel, twice
+    //    (once to count, once to write at the counted offsets), so that no
+    //    buffer of the upper-bound size is needed.
     const std::size_t rv = bucket_begin[count]; // the reverse edges of later points start here
-    upper.resize(count + 1);
-    upper[0] = 0;
-    for (std::size_t q = 0; q < count; ++q)
-      upper[q + 1] = upper[q] + k + (bucket_begin[q + 1] - bucket_begin[q]);
-    scratch.resize(upper[count]);
+    auto list_of = [&](std::size_t q, std::vector<Sweep_neighbor>& list) {
+      const std::uint64_t sp = finalized + q;
+      list.clear();
+      for (unsigned int t = 0; t < k; ++t) {
+        const std::uint32_t j = knn[q * k + t];
+        if (j == ~std::uint32_t(0) || !(double(knn_d2[q * k + t]) < r2))
+          continue;
+        const std::uint64_t sj = window.m_base + j;
+        if (sj < sp)
+          list.push_back(Sweep_neighbor{sj, knn_d2[q * k + t]});
+      }
+      for (std::size_t v = bucket_begin[q]; v < bucket_begin[q + 1]; ++v)
+        list.push_back(Sweep_neighbor{reverse[v].source, reverse[v].squared_distance});
+      std::sort(list.begin(), list.end(),
+                [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence < c.sequence; });
+      list.erase(std::unique(list.begin(), list.end(),
+                             [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence == c.sequence; }),
+                 list.end());
+    };
     batch_first.resize(count + 1);
     batch_first[0] = 0;
     Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
+      std::vector<Sweep_neighbor> list;
       for (std::size_t q = b; q < e; ++q) {
-        const std::uint64_t sp = finalized + q;
-        Sweep_neighbor* const first = scratch.data() + upper[q];
-        Sweep_neighbor* last = first;
-        for (unsigned int t = 0; t < k; ++t) {
-          const std::uint32_t j = knn[q * k + t];
-          if (j == ~std::uint32_t(0) || !(double(knn_d2[q * k + t]) < r2))
-            continue;
-          const std::uint64_t sj = window.m_base + j;
-          if (sj < sp)
-            *last++ = Sweep_neighbor{sj, knn_d2[q * k + t]};
-        }
-        for (std::size_t v = bucket_begin[q]; v < bucket_begin[q + 1]; ++v)
-          *last++ = Sweep_neighbor{reverse[v].source, reverse[v].squared_distance};
-        std::sort(first, last, [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence < c.sequence; });
-        last = std::unique(first, last,
-                           [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence == c.sequence; });
-        batch_first[q + 1] = std::size_t(last - first); // the count, for now
+        list_of(q, list);
+        batch_first[q + 1] = list.size(); // the count, for now
       }
     }, 1024);
     for (std::size_t q = 0; q < count; ++q)
       batch_first[q + 1] += batch_first[q];
     batch_neighbors.resize(batch_first[count]);
     Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
-      for (std::size_t q = b; q < e; ++q)
-        std::copy(scratch.begin() + std::ptrdiff_t(upper[q]),
-                  scratch.begin() + std::ptrdiff_t(upper[q] + batch_first[q + 1] - batch_first[q]),
-                  batch_neighbors.begin() + std::ptrdiff_t(batch_first[q]));
-    }, 4096);
+      std::vector<Sweep_neighbor> list;
+      for (std::size_t q = b; q < e; ++q) {
+        list_of(q, list);
+        std::copy(list.begin(), list.end(), batch_neighbors.begin() + std::ptrdiff_t(batch_first[q]));
+      }
+    }, 1024);
     report.number_of_edges += batch_neighbors.size();
     if constexpr (internal::Has_prepare<Visitor, Sweep_window<Payload>>::value)
       visitor.prepare(window, finalized, batch_first, batch_neighbors);
