@@ -7,11 +7,14 @@
 /// streaming_orient_normals.h: presorted input, component files and the
 /// minimum component size, progress and cancellation, and the bounded window.
 
+#include <Normal_orientation/streaming/Point_range.h>
 #include <Normal_orientation/streaming/external_sort.h>
 #include <Normal_orientation/streaming_orient_normals.h>
 
 #include "Test_directory.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/property_map.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -1200,3 +1203,88 @@ TEST(Streaming_window, PeakDoesNotGrowWithTheLength)
 }
 
 } // namespace
+
+namespace {
+
+typedef CGAL::Exact_predicates_inexact_constructions_kernel Range_kernel;
+typedef std::pair<Range_kernel::Point_3, Range_kernel::Vector_3> Point_with_normal;
+
+} // namespace
+
+// The range adaptor: a user's vector of (point, normal) pairs, presorted
+// along x, streamed through make_point_range_source and written back in
+// place by make_normal_writer, gives the orientation of the file path, and
+// the adaptor's order check names the first point out of order.
+TEST(Streaming_point_range, OrientsAUserRangeInPlaceAndChecksItsOrder)
+{
+  namespace NP = Normal_orientation::parameters;
+  Temporary_directory directory;
+  std::mt19937_64 rng(29);
+  Test_cloud cloud;
+  cloud.ellipsoid(15000, Vec{{0.5, 1., -1.}}, 3., 1.2, 0.8, rng);
+  std::vector<Point_record> sorted = sorted_by(cloud.records, 0);
+  std::vector<Point_with_normal> points;
+  std::vector<Vec> truth;
+  for (std::size_t i = 0; i < sorted.size(); ++i) {
+    const Point_record& r = sorted[i];
+    points.emplace_back(Range_kernel::Point_3(r.position[0], r.position[1], r.position[2]),
+                        Range_kernel::Vector_3(r.normal[0], r.normal[1], r.normal[2]));
+    truth.push_back(cloud.truth[r.index]);
+    sorted[i].index = i; // as the adaptor numbers them
+  }
+  const auto np = NP::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
+                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  std::vector<Point_with_normal> original = points;
+
+  // the reference: the same records through a plain vector source
+  Vector_source reference_source(sorted);
+  NO::Streaming_options options = streaming_options_in(directory.path());
+  options.presorted_axis = NO::Presorted_axis::X;
+  std::vector<Point_record> reference;
+  const NO::Streaming_result rr = stream(reference_source, options, reference);
+  ASSERT_EQ(reference.size(), points.size());
+
+  auto source = ns::make_point_range_source(points, np, 0);
+  EXPECT_EQ(source.size(), points.size());
+  auto sink = ns::make_normal_writer(points, np);
+  const NO::Streaming_result result = NO::streaming_orient_normals(source, sink, options);
+  EXPECT_EQ(result.number_of_points, points.size());
+  EXPECT_EQ(result.number_of_edges, rr.number_of_edges);
+  std::size_t wrong = 0, differ = 0, moved = 0;
+  for (const Point_record& r : reference) { // the reference's index is the position in `points`
+    const Range_kernel::Vector_3& n = points[r.index].second;
+    wrong += dot(Vec{{n.x(), n.y(), n.z()}}, truth[r.index]) <= 0.0 ? 1 : 0;
+    differ += (n.x() != r.normal[0] || n.y() != r.normal[1] || n.z() != r.normal[2]) ? 1 : 0;
+    moved += points[r.index].first != original[r.index].first ? 1 : 0;
+    // only the sign of a normal may change
+    const Range_kernel::Vector_3& m = original[r.index].second;
+    EXPECT_TRUE(n == m || n == -m);
+  }
+  EXPECT_EQ(differ, 0u) << "the in-place result differs from the vector source's";
+  EXPECT_EQ(moved, 0u);
+  EXPECT_LE(wrong, points.size() / 200) << wrong << " wrong normals";
+
+  // the order check of the adaptor: swap two points far apart along x
+  std::swap(points[100], points[9000]);
+  auto bad = ns::make_point_range_source(points, np, 0);
+  std::vector<Point_record> chunk;
+  try {
+    while (bad.read(chunk, 4096) > 0) {
+    }
+    ADD_FAILURE() << "the order check did not fire";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("not sorted by increasing x at point 101"), std::string::npos) << e.what();
+  }
+  // rewind starts again; without a checked axis nothing is checked
+  auto unchecked = ns::make_point_range_source(points, np);
+  chunk.clear();
+  while (unchecked.read(chunk, 4096) > 0) {
+  }
+  EXPECT_EQ(chunk.size(), points.size());
+  EXPECT_EQ(chunk[100].index, 100u);
+  unchecked.rewind();
+  chunk.clear();
+  EXPECT_EQ(unchecked.read(chunk, 10), 10u);
+  EXPECT_EQ(chunk[0].index, 0u);
+  EXPECT_THROW(ns::make_point_range_source(points, np, 3), std::invalid_argument);
+}
