@@ -25,6 +25,7 @@
 #include <chrono>
 #include <condition_variable>
 #include <exception>
+#include <future>
 #include <mutex>
 #include <thread>
 #include <cmath>
@@ -238,13 +239,15 @@ struct Has_prepare<Visitor, Window,
 /// released (`visitor.release(window, sequence)`, in order) once no point
 /// that may still need it remains to be finalised; then it leaves the
 /// window.  The window holds at most the points of a slab of thickness 3r
-/// plus one batch and one read (min(batch, 65536) points): memory does not
-/// grow with the cloud.
+/// plus two batches and one read (min(batch, 65536) points): memory does
+/// not grow with the length of the cloud.
 ///
 /// Unlike the reference code, which locks grid cells, the sweep works in
-/// phases: a batch of points is finalised with one CGAL kd-tree built over
-/// the window and queried in parallel (read only, no locks), then the
-/// visitor runs sequentially in the sweep order.  The result is the same
+/// phases: the neighbours of a batch of points are searched with one CGAL
+/// kd-tree built over a copy of the window and queried in parallel (read
+/// only, no locks), on a thread of its own while the previous batch is
+/// finalised (the visitor runs sequentially in the sweep order; with
+/// `CGAL::Sequential_tag` the two run one after the other).  The result is the same
 /// for any number of threads.  The k nearest neighbours are those of the
 /// whole cloud for every neighbour closer than r (the points left out of
 /// the window are all farther), so the graph is exactly the in-core graph,
@@ -280,10 +283,24 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
   internal::Prefetcher<Source> prefetcher(source, read_size);
   auto& slots = window.m_slots;
   std::uint64_t finalized = window.m_base + slots.size(); // the next point to finalise
+  std::uint64_t queried = finalized;                      // the next point to query
   std::uint64_t read_count = 0;
   double last_key = -std::numeric_limits<double>::infinity();
   bool at_end = false;
   std::vector<Point_record> chunk;
+
+  // A batch whose neighbours are being, or have been, searched: points
+  // [first, first + count); knn holds sequence numbers - base.
+  struct Job
+  {
+    std::uint64_t first = 0, base = 0;
+    std::size_t count = 0;
+    std::vector<std::uint32_t> knn;
+    std::vector<float> knn_d2;
+  };
+  Job jobs[2];
+  int current = 0;
+  bool pending = false; // jobs[1 - current] is searched, not yet finalised
 
   // reverse edges: (later end, earlier end, squared distance)
   struct Reverse
@@ -299,97 +316,94 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed; // (Morton code, slot), sorted
   std::vector<std::uint32_t> queries;                          // tree positions of the batch
   std::vector<double> part_box;
-  std::vector<std::uint32_t> knn;
-  std::vector<float> knn_d2;
   std::vector<Sweep_neighbor> earlier;
 
-  while (true) {
-    // 1. Read until a batch can be finalised (or the input ends).
-    auto finalizable = [&]() -> std::uint64_t { // one past the last point that may be finalised
-      if (at_end)
-        return window.m_base + slots.size();
-      std::uint64_t e = finalized;
-      while (e < window.m_base + slots.size() && slots[std::size_t(e - window.m_base)].key + r <= last_key)
-        ++e;
-      return e;
-    };
-    std::uint64_t ready = finalizable();
-    while (!at_end && ready - finalized < batch) {
-      chunk.clear();
-      const std::size_t got = prefetcher.read(chunk);
-      if (got == 0) {
-        at_end = true;
-        break;
-      }
-      for (const Point_record& p : chunk) {
-        const double kp = double(key(p));
-        if (!std::isfinite(kp) || kp < last_key) {
-          std::ostringstream msg;
-          msg << "sweep: the input is not sorted along the sweep axis at point " << read_count << " (input index "
-              << p.index << ")";
-          throw std::runtime_error(msg.str());
-        }
-        last_key = kp;
-        slots.push_back(typename Sweep_window<Payload>::Slot{p, kp, Payload()});
-        ++read_count;
-      }
-      report.peak_window = std::max(report.peak_window, slots.size());
-      ready = finalizable();
-    }
-    ready = finalizable();
-    if (ready == finalized) {
-      if (at_end)
-        break;
-      continue;
-    }
-
-    // 2. kNN of the points [finalized, ready) over the window.  The tree is
-    //    built over the window's points in Morton order, and the batch is
-    //    queried in that order: consecutive queries then visit the same
-    //    leaves, several times faster than in the sweep order, whose
-    //    consecutive points lie far apart across the slab.
+  // The neighbours of the points [first, first + count) over a copy of the
+  // window (points in Morton order, slots from `base`): the tree is built
+  // over the window's points in Morton order and the batch is queried in
+  // that order, so that consecutive queries visit the same leaves (several
+  // times faster than in the sweep order, whose consecutive points lie far
+  // apart across the slab).  Runs while the previous batch is finalised.
+  auto search = [&](Job& job) {
     const auto t0 = std::chrono::steady_clock::now();
-    const std::size_t w = slots.size();
-    const std::size_t first_slot = std::size_t(finalized - window.m_base);
-    const std::size_t count = std::size_t(ready - finalized);
+    const std::size_t w = points.size();
+    const Point_pmap pmap = CGAL::make_property_map(static_cast<const std::vector<Point>&>(points));
+    Tree tree(boost::counting_iterator<std::uint32_t>(0), boost::counting_iterator<std::uint32_t>(std::uint32_t(w)),
+              typename Types::Splitter(), typename Types::Traits(pmap));
+    tree.template build<ConcurrencyTag>();
+    const Distance distance(pmap);
+    const std::size_t first_slot = std::size_t(job.first - job.base);
+    job.knn.assign(job.count * k, ~std::uint32_t(0));
+    job.knn_d2.assign(job.count * k, 0.f);
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(queries.size(), [&](std::size_t b, std::size_t e) {
+      std::vector<std::uint32_t> nb(k);
+      for (std::size_t q = b; q < e; ++q) {
+        const std::uint32_t i = queries[q];
+        const std::size_t row = std::size_t(keyed[i].second - first_slot) * k;
+        const unsigned int found = Types::nearest(tree, distance, points[i], i, k, nb.data(), &job.knn_d2[row]);
+        for (unsigned int t = 0; t < found; ++t)
+          job.knn[row + t] = keyed[nb[t]].second; // tree position -> slot
+      }
+    }, 256);
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+
+  // The window's points, in Morton order, for the search of `job`.
+  auto snapshot = [&](const Job& job) {
+    const std::size_t first_slot = std::size_t(job.first - job.base);
+    // Only the points within r of the batch along the axis can be its
+    // neighbours (a margin covers the rounding of the squared distances):
+    // the points of the previous batch, not yet released, mostly are not.
+    const double from = slots[first_slot].key - r * (1.0 + 1e-6);
+    std::size_t s0 = first_slot;
     {
-      // the bounding box, in a fixed number of parts (deterministic)
-      const std::size_t parts = 64;
-      part_box.assign(parts * 6, 0.0);
-      Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(parts, [&](std::size_t pb, std::size_t pe) {
-        for (std::size_t part = pb; part < pe; ++part) {
-          double* box = &part_box[part * 6];
-          for (int d = 0; d < 3; ++d) {
-            box[d] = HUGE_VAL;
-            box[3 + d] = -HUGE_VAL;
-          }
-          for (std::size_t s = w * part / parts; s < w * (part + 1) / parts; ++s)
-            for (int d = 0; d < 3; ++d) {
-              box[d] = std::min(box[d], slots[s].record.position[d]);
-              box[3 + d] = std::max(box[3 + d], slots[s].record.position[d]);
-            }
-        }
-      }, 1);
-      double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
-      for (std::size_t part = 0; part < parts; ++part)
-        for (int d = 0; d < 3; ++d) {
-          lo[d] = std::min(lo[d], part_box[part * 6 + d]);
-          hi[d] = std::max(hi[d], part_box[part * 6 + 3 + d]);
-        }
-      const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
-      const double scale = extent > 0.0 ? double((1u << 21) - 1) / extent : 0.0;
-      keyed.resize(w);
-      Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(w, [&](std::size_t b, std::size_t e) {
-        for (std::size_t s = b; s < e; ++s) {
-          const double* p = slots[s].record.position;
-          std::uint64_t code = 0;
-          for (int d = 0; d < 3; ++d)
-            code |= Normal_orientation::internal::spread_bits_3(std::uint64_t((p[d] - lo[d]) * scale)) << d;
-          keyed[s] = {code, std::uint32_t(s)};
-        }
-      });
-      Normal_orientation::internal::parallel_sort<ConcurrencyTag>(keyed, std::less<std::pair<std::uint64_t, std::uint32_t>>());
+      std::size_t lo = 0, hi = first_slot; // the first slot with key > from
+      while (lo < hi) {
+        const std::size_t mid = lo + (hi - lo) / 2;
+        if (slots[mid].key > from)
+          hi = mid;
+        else
+          lo = mid + 1;
+      }
+      s0 = lo;
     }
+    const std::size_t w = slots.size() - s0;
+    // the bounding box, in a fixed number of parts (deterministic)
+    const std::size_t parts = 64;
+    part_box.assign(parts * 6, 0.0);
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(parts, [&](std::size_t pb, std::size_t pe) {
+      for (std::size_t part = pb; part < pe; ++part) {
+        double* box = &part_box[part * 6];
+        for (int d = 0; d < 3; ++d) {
+          box[d] = HUGE_VAL;
+          box[3 + d] = -HUGE_VAL;
+        }
+        for (std::size_t s = s0 + w * part / parts; s < s0 + w * (part + 1) / parts; ++s)
+          for (int d = 0; d < 3; ++d) {
+            box[d] = std::min(box[d], slots[s].record.position[d]);
+            box[3 + d] = std::max(box[3 + d], slots[s].record.position[d]);
+          }
+      }
+    }, 1);
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (std::size_t part = 0; part < parts; ++part)
+      for (int d = 0; d < 3; ++d) {
+        lo[d] = std::min(lo[d], part_box[part * 6 + d]);
+        hi[d] = std::max(hi[d], part_box[part * 6 + 3 + d]);
+      }
+    const double extent = std::max({hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]});
+    const double scale = extent > 0.0 ? double((1u << 21) - 1) / extent : 0.0;
+    keyed.resize(w);
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(w, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const double* p = slots[s0 + i].record.position;
+        std::uint64_t code = 0;
+        for (int d = 0; d < 3; ++d)
+          code |= Normal_orientation::internal::spread_bits_3(std::uint64_t((p[d] - lo[d]) * scale)) << d;
+        keyed[i] = {code, std::uint32_t(s0 + i)};
+      }
+    });
+    Normal_orientation::internal::parallel_sort<ConcurrencyTag>(keyed, std::less<std::pair<std::uint64_t, std::uint32_t>>());
     points.resize(w);
     Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(w, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) {
@@ -399,37 +413,24 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
     });
     queries.clear();
     for (std::size_t i = 0; i < w; ++i)
-      if (keyed[i].second >= first_slot && keyed[i].second - first_slot < count)
+      if (keyed[i].second >= first_slot && keyed[i].second - first_slot < job.count)
         queries.push_back(std::uint32_t(i));
-    const Point_pmap pmap = CGAL::make_property_map(static_cast<const std::vector<Point>&>(points));
-    Tree tree(boost::counting_iterator<std::uint32_t>(0), boost::counting_iterator<std::uint32_t>(std::uint32_t(w)),
-              typename Types::Splitter(), typename Types::Traits(pmap));
-    tree.template build<ConcurrencyTag>();
-    const Distance distance(pmap);
-    knn.assign(count * k, ~std::uint32_t(0));
-    knn_d2.assign(count * k, 0.f);
-    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(queries.size(), [&](std::size_t b, std::size_t e) {
-      std::vector<std::uint32_t> nb(k);
-      for (std::size_t q = b; q < e; ++q) {
-        const std::uint32_t i = queries[q];
-        const std::size_t row = std::size_t(keyed[i].second - first_slot) * k;
-        const unsigned int found = Types::nearest(tree, distance, points[i], i, k, nb.data(), &knn_d2[row]);
-        for (unsigned int t = 0; t < found; ++t)
-          knn[row + t] = keyed[nb[t]].second; // tree position -> slot
-      }
-    }, 256);
-    report.seconds_neighbors += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    ++report.number_of_batches;
+  };
 
-    // 3. Reverse edges from this batch to later points.
+  // Finalises the searched batch `job` (its points are still in the window,
+  // whose front may have moved since the search) and releases what no
+  // later point can need.
+  auto finish = [&](Job& job) {
+    const std::size_t count = job.count;
+    // 1. Reverse edges from this batch to later points.
     for (std::size_t q = 0; q < count; ++q)
       for (unsigned int t = 0; t < k; ++t) {
-        const std::uint32_t j = knn[q * k + t];
-        if (j == ~std::uint32_t(0) || !(double(knn_d2[q * k + t]) < r2))
+        const std::uint32_t j = job.knn[q * k + t];
+        if (j == ~std::uint32_t(0) || !(double(job.knn_d2[q * k + t]) < r2))
           continue;
-        const std::uint64_t sj = window.m_base + j, sp = finalized + q;
+        const std::uint64_t sj = job.base + j, sp = job.first + q;
         if (sj > sp)
-          reverse.push_back({sj, sp, knn_d2[q * k + t]});
+          reverse.push_back({sj, sp, job.knn_d2[q * k + t]});
       }
     // Bucket them by target (a stable counting sort over the targets still
     // in the window, all at or after `finalized`); the order within a
@@ -448,24 +449,23 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
       reverse.swap(bucketed);
     }
 
-    // 4. The earlier neighbours of every point of the batch (sorted by
-    //    sequence number), then the visitor: `prepare` on the whole batch
-    //    when it has one (it may work in parallel), then `finalize` in order.
-    //    Point q's list: its own earlier kNN, then the reverse edges of
-    //    bucket q, sorted and without duplicates; built in parallel, twice
-    //    (once to count, once to write at the counted offsets), so that no
-    //    buffer of the upper-bound size is needed.
+    // 2. The earlier neighbours of every point of the batch (sorted by
+    //    sequence number): its own earlier kNN, then the reverse edges of
+    //    bucket q, without duplicates; built in parallel, twice (once to
+    //    count, once to write at the counted offsets).  Then the visitor:
+    //    `prepare` on the whole batch when it has one (it may work in
+    //    parallel), then `finalize` in order.
     const std::size_t rv = bucket_begin[count]; // the reverse edges of later points start here
     auto list_of = [&](std::size_t q, std::vector<Sweep_neighbor>& list) {
-      const std::uint64_t sp = finalized + q;
+      const std::uint64_t sp = job.first + q;
       list.clear();
       for (unsigned int t = 0; t < k; ++t) {
-        const std::uint32_t j = knn[q * k + t];
-        if (j == ~std::uint32_t(0) || !(double(knn_d2[q * k + t]) < r2))
+        const std::uint32_t j = job.knn[q * k + t];
+        if (j == ~std::uint32_t(0) || !(double(job.knn_d2[q * k + t]) < r2))
           continue;
-        const std::uint64_t sj = window.m_base + j;
+        const std::uint64_t sj = job.base + j;
         if (sj < sp)
-          list.push_back(Sweep_neighbor{sj, knn_d2[q * k + t]});
+          list.push_back(Sweep_neighbor{sj, job.knn_d2[q * k + t]});
       }
       for (std::size_t v = bucket_begin[q]; v < bucket_begin[q + 1]; ++v)
         list.push_back(Sweep_neighbor{reverse[v].source, reverse[v].squared_distance});
@@ -496,19 +496,20 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
     }, 1024);
     report.number_of_edges += batch_neighbors.size();
     if constexpr (internal::Has_prepare<Visitor, Sweep_window<Payload>>::value)
-      visitor.prepare(window, finalized, batch_first, batch_neighbors);
+      visitor.prepare(window, job.first, batch_first, batch_neighbors);
     for (std::size_t q = 0; q < count; ++q) {
       earlier.assign(batch_neighbors.begin() + std::ptrdiff_t(batch_first[q]),
                      batch_neighbors.begin() + std::ptrdiff_t(batch_first[q + 1]));
-      visitor.finalize(window, finalized + q, earlier);
+      visitor.finalize(window, job.first + q, earlier);
     }
     reverse.erase(reverse.begin(), reverse.begin() + std::ptrdiff_t(rv));
-    finalized = ready;
+    finalized = job.first + count;
     report.number_of_points += count;
 
-    // 5. Release the points that no point still to finalise can need: the
+    // 3. Release the points that no point still to finalise can need: the
     //    first unfinalised point, or the next one to be read, has a key at
-    //    least `limit`.
+    //    least `limit` (the batch being searched keeps its own copy of the
+    //    points, and its neighbours are all within r of its first point).
     const bool all_done = finalized == window.m_base + slots.size();
     const double limit = !all_done ? slots[std::size_t(finalized - window.m_base)].key
                                    : at_end ? std::numeric_limits<double>::infinity() : last_key;
@@ -517,8 +518,81 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
       slots.pop_front();
       ++window.m_base;
     }
-    if (at_end && all_done)
+  };
+
+  while (true) {
+    // 1. Read until a batch can be searched (or the input ends): point p can
+    //    once every point with a key below key(p) + r has been read.
+    auto searchable = [&]() -> std::uint64_t { // one past the last point that may be searched
+      if (at_end)
+        return window.m_base + slots.size();
+      std::uint64_t e = queried;
+      while (e < window.m_base + slots.size() && slots[std::size_t(e - window.m_base)].key + r <= last_key)
+        ++e;
+      return e;
+    };
+    std::uint64_t ready = searchable();
+    while (!at_end && ready - queried < batch) {
+      chunk.clear();
+      const std::size_t got = prefetcher.read(chunk);
+      if (got == 0) {
+        at_end = true;
+        break;
+      }
+      for (const Point_record& p : chunk) {
+        const double kp = double(key(p));
+        if (!std::isfinite(kp) || kp < last_key) {
+          std::ostringstream msg;
+          msg << "sweep: the input is not sorted along the sweep axis at point " << read_count << " (input index "
+              << p.index << ")";
+          throw std::runtime_error(msg.str());
+        }
+        last_key = kp;
+        slots.push_back(typename Sweep_window<Payload>::Slot{p, kp, Payload()});
+        ++read_count;
+      }
+      report.peak_window = std::max(report.peak_window, slots.size());
+      ready = searchable();
+    }
+    ready = searchable();
+    if (ready == queried) {
+      if (!at_end)
+        continue;
+      if (pending) // the last batch; then every point is released
+        finish(jobs[1 - current]);
       break;
+    }
+
+    // 2. Search batch [queried, ready) on a thread of its own while the
+    //    previous batch is finalised on this one.
+    Job& job = jobs[current];
+    job.first = queried;
+    job.base = window.m_base;
+    job.count = std::size_t(ready - queried);
+    snapshot(job);
+    if (!std::is_convertible<ConcurrencyTag, CGAL::Parallel_tag>::value) {
+      report.seconds_neighbors += search(job); // one thread: one after the other
+      if (pending)
+        finish(jobs[1 - current]);
+    } else {
+      std::future<double> searching = std::async(std::launch::async, [&]() { return search(job); });
+      struct Wait // on exceptions too: `search` uses this frame
+      {
+        std::future<double>& f;
+        ~Wait()
+        {
+          if (f.valid())
+            f.wait();
+        }
+      } wait{searching};
+      if (pending)
+        finish(jobs[1 - current]);
+      report.seconds_neighbors += searching.get();
+    }
+    ++report.number_of_batches;
+    queried = ready;
+    pending = true;
+    current = 1 - current;
   }
   return report;
 }
