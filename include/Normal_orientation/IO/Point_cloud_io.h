@@ -62,10 +62,16 @@
 namespace Normal_orientation {
 namespace IO {
 
+/// \addtogroup PkgNormalOrientationIO
+/// @{
+
 /// \brief Exception thrown by every reading and writing function of this header.
 ///
 /// The message is a single line that starts with the name of the file concerned and,
-/// where it applies, names the line number (1-based) or the vertex index (0-based).
+/// where it applies, names the line number (1-based) or the vertex index (0-based) and
+/// the byte offset (binary PLY data). Bytes of the input quoted in a message (a bad
+/// token, an unknown keyword) are written `\xNN` unless they are printable ASCII
+/// characters.
 class Io_error : public std::runtime_error
 {
 public:
@@ -166,8 +172,9 @@ struct Point_cloud
   std::array<Ply_scalar_type, 3> point_types{
     {Ply_scalar_type::FLOAT64, Ply_scalar_type::FLOAT64, Ply_scalar_type::FLOAT64}};
   /// PLY types of `nx ny nz`: those of the PLY input, `FLOAT32` otherwise. They are
-  /// used when writing a PLY file, except integer types, which are replaced by
-  /// `FLOAT32` as they cannot hold unit normals.
+  /// used when writing a PLY file, except integer types, which cannot hold unit normals:
+  /// they are replaced by `FLOAT32` (8- and 16-bit types, whose values a `float` holds
+  /// exactly) or `FLOAT64` (32-bit types), so that the values read are written exactly.
   std::array<Ply_scalar_type, 3> normal_types{
     {Ply_scalar_type::FLOAT32, Ply_scalar_type::FLOAT32, Ply_scalar_type::FLOAT32}};
   /// Largest number of significant decimal digits of a coordinate of a `.xyz`/`.pwn`
@@ -268,14 +275,43 @@ inline bool is_blank(char c)
   return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
 
-/// \brief `token` quoted and shortened for an error message.
-inline std::string quoted(const char* begin, const char* end)
+/// \brief Returns `true` if `c` is a control character (a byte below 32, or 127).
+inline bool is_control(char c)
+{
+  const unsigned char byte = static_cast<unsigned char>(c);
+  return byte < 0x20 || byte == 0x7F;
+}
+
+/// \brief Appends `c` to `text`, written `\xNN` unless it is a printable ASCII
+/// character.
+inline void append_printable(std::string& text, char c)
+{
+  const unsigned char byte = static_cast<unsigned char>(c);
+  if(!is_control(c) && byte < 0x80) {
+    text += c;
+    return;
+  }
+  static const char digits[] = "0123456789abcdef";
+  text += "\\x";
+  text += digits[byte >> 4];
+  text += digits[byte & 0xF];
+}
+
+/// \brief `[begin, end)` quoted for an error message, with its bytes other than
+/// printable ASCII characters (control characters, bytes above 126) written `\xNN`, so
+/// that the message stays one printable line whatever the input, and shortened to about
+/// 40 characters (`...` then ends it).
+inline std::string quote(const char* begin, const char* end)
 {
   const std::size_t max_length = 40;
-  std::string text(begin, std::min<std::size_t>(static_cast<std::size_t>(end - begin), max_length));
-  if(static_cast<std::size_t>(end - begin) > max_length) text += "...";
-  return "'" + text + "'";
+  std::string text = "'";
+  for(; begin != end && text.size() <= max_length; ++begin) append_printable(text, *begin);
+  if(begin != end) text += "...";
+  return text + "'";
 }
+
+/// \brief `token` quoted, shortened and made printable for an error message.
+inline std::string quote(std::string_view token) { return quote(token.data(), token.data() + token.size()); }
 
 /// \brief The whole content of a file.
 struct File_content
@@ -544,6 +580,15 @@ inline bool is_floating(Ply_scalar_type type)
   return type == Ply_scalar_type::FLOAT32 || type == Ply_scalar_type::FLOAT64;
 }
 
+/// \brief Type in which `write_ply()` writes normals of type `type`: `type` itself if
+/// it is a floating type, otherwise the smallest floating type that holds every value of
+/// `type` exactly (`FLOAT32` for 8- and 16-bit integers, `FLOAT64` for 32-bit ones).
+inline Ply_scalar_type written_normal_type(Ply_scalar_type type)
+{
+  if(is_floating(type)) return type;
+  return ply_scalar_type_size(type) <= 2 ? Ply_scalar_type::FLOAT32 : Ply_scalar_type::FLOAT64;
+}
+
 /// \brief Returns `true` if `value` can be stored exactly as `type` (any value fits
 /// `FLOAT64`; `FLOAT32` rounds finite values but must not overflow).
 inline bool is_representable(double value, Ply_scalar_type type)
@@ -555,15 +600,18 @@ inline bool is_representable(double value, Ply_scalar_type type)
   return value >= range.first && value <= range.second && value == std::trunc(value);
 }
 
-/// \brief Parses one value of an ASCII PLY file as `type`. A `FLOAT32` value is rounded
-/// to `float`, as a binary file would store it.
+/// \brief Parses one value of an ASCII PLY file as `type`. A `FLOAT32` value is the
+/// `float` nearest to the decimal number, as a binary file would store it (so that the
+/// shortest text of any `float`, e.g. `3.4028235e+38` for the largest one, reads back
+/// exactly); a value too small for a `float` becomes 0 (or the nearest subnormal). An
+/// integer value may be written as a real (`255.0`); `-0` is read as 0.
 inline Parse_status parse_ply_ascii_value(const char* begin, const char* end,
                                           Ply_scalar_type type, double& value)
 {
+  const char* const unsigned_first = (begin != end && *begin == '+') ? begin + 1 : begin;
   if(!is_floating(type)) {
-    const char* first = (begin != end && *begin == '+') ? begin + 1 : begin;
     long long integer = 0;
-    const std::from_chars_result result = std::from_chars(first, end, integer);
+    const std::from_chars_result result = std::from_chars(unsigned_first, end, integer);
     if(result.ec == std::errc() && result.ptr == end) {
       value = static_cast<double>(integer);
     } else {
@@ -571,14 +619,24 @@ inline Parse_status parse_ply_ascii_value(const char* begin, const char* end,
       const Parse_status status = parse_real(begin, end, value);
       if(status != Parse_status::OK) return status;
       if(!std::isfinite(value)) return Parse_status::OUT_OF_RANGE;
+      if(value == 0.0) value = 0.0; // -0.0: an integer has no negative zero
     }
     return is_representable(value, type) ? Parse_status::OK : Parse_status::OUT_OF_RANGE;
   }
   const Parse_status status = parse_real(begin, end, value);
   if(status != Parse_status::OK) return status;
-  if(type == Ply_scalar_type::FLOAT32) {
-    if(!is_representable(value, type)) return Parse_status::OUT_OF_RANGE;
-    value = static_cast<double>(static_cast<float>(value));
+  if(type == Ply_scalar_type::FLOAT32 && std::isfinite(value)) {
+    // Rounding the decimal number to a double, then to a float, could miss the nearest
+    // float (and refuses the decimal numbers between FLT_MAX and the half-way point to
+    // the next power of two): read the float directly. The syntax was checked above.
+    float single = 0.0f;
+    const std::from_chars_result result = std::from_chars(unsigned_first, end, single);
+    if(result.ec == std::errc() && result.ptr == end) {
+      value = static_cast<double>(single);
+    } else {
+      if(std::fabs(value) > double(std::numeric_limits<float>::max())) return Parse_status::OUT_OF_RANGE;
+      value = static_cast<double>(static_cast<float>(value)); // underflow: 0 or a subnormal
+    }
   }
   return Parse_status::OK;
 }
@@ -725,6 +783,11 @@ inline Ply_header parse_ply_header(const std::string& filename, const char* begi
   auto bad = [&filename](std::size_t line, const std::string& what) {
     fail(filename, "bad PLY header at line " + std::to_string(line) + ": " + what);
   };
+  // Names are quoted in messages and written back to PLY headers: no control characters.
+  auto check_name = [&bad](std::size_t line, std::string_view name) {
+    if(std::any_of(name.begin(), name.end(), is_control)) bad(line, "control character in the name " + quote(name));
+  };
+  if(begin == end) fail(filename, "not a PLY file: the file is empty");
   Ply_header header;
   bool has_format = false;
   bool has_end = false;
@@ -756,12 +819,13 @@ inline Ply_header parse_ply_header(const std::string& filename, const char* begi
       if(tokens[1] == "ascii") header.format = Ply_format::ASCII;
       else if(tokens[1] == "binary_little_endian") header.format = Ply_format::BINARY_LITTLE_ENDIAN;
       else if(tokens[1] == "binary_big_endian") header.format = Ply_format::BINARY_BIG_ENDIAN;
-      else bad(line, "unknown format '" + std::string(tokens[1]) + "'");
-      if(tokens[2] != "1.0") bad(line, "unsupported PLY version '" + std::string(tokens[2]) + "'");
+      else bad(line, "unknown format " + quote(tokens[1]));
+      if(tokens[2] != "1.0") bad(line, "unsupported PLY version " + quote(tokens[2]));
       has_format = true;
     } else if(keyword == "element") {
       if(tokens.size() != 3) bad(line, "expected 'element <name> <count>'");
       Ply_header_element element;
+      check_name(line, tokens[1]);
       element.name = std::string(tokens[1]);
       element.line = line;
       unsigned long long count = 0;
@@ -769,10 +833,10 @@ inline Ply_header parse_ply_header(const std::string& filename, const char* begi
       const char* last = first + tokens[2].size();
       const std::from_chars_result result = std::from_chars(first, last, count);
       if(result.ec != std::errc() || result.ptr != last || count > std::numeric_limits<std::size_t>::max())
-        bad(line, "invalid element count '" + std::string(tokens[2]) + "'");
+        bad(line, "invalid element count " + quote(tokens[2]));
       element.count = static_cast<std::size_t>(count);
       for(const Ply_header_element& other : header.elements)
-        if(other.name == element.name) bad(line, "second element '" + element.name + "'");
+        if(other.name == element.name) bad(line, "second element " + quote(element.name));
       if(element.name == "vertex") {
         has_vertex = true;
         header.vertex_element = header.elements.size();
@@ -786,27 +850,29 @@ inline Ply_header parse_ply_header(const std::string& filename, const char* begi
         if(tokens.size() != 5) bad(line, "expected 'property list <count type> <item type> <name>'");
         const std::optional<Ply_scalar_type> count_type = ply_scalar_type_from_name(tokens[2]);
         const std::optional<Ply_scalar_type> item_type = ply_scalar_type_from_name(tokens[3]);
-        if(!count_type) bad(line, "unknown type '" + std::string(tokens[2]) + "'");
-        if(!item_type) bad(line, "unknown type '" + std::string(tokens[3]) + "'");
+        if(!count_type) bad(line, "unknown type " + quote(tokens[2]));
+        if(!item_type) bad(line, "unknown type " + quote(tokens[3]));
         if(is_floating(*count_type)) bad(line, "the count type of a list must be an integer type");
         property.is_list = true;
         property.count_type = *count_type;
         property.type = *item_type;
+        check_name(line, tokens[4]);
         property.name = std::string(tokens[4]);
       } else {
         if(tokens.size() != 3) bad(line, "expected 'property <type> <name>'");
         const std::optional<Ply_scalar_type> type = ply_scalar_type_from_name(tokens[1]);
-        if(!type) bad(line, "unknown type '" + std::string(tokens[1]) + "'");
+        if(!type) bad(line, "unknown type " + quote(tokens[1]));
         property.type = *type;
+        check_name(line, tokens[2]);
         property.name = std::string(tokens[2]);
       }
       Ply_header_element& element = header.elements.back();
       for(const Ply_header_property& other : element.properties)
         if(other.name == property.name)
-          bad(line, "second property '" + property.name + "' in element '" + element.name + "'");
+          bad(line, "second property " + quote(property.name) + " in element " + quote(element.name));
       element.properties.push_back(std::move(property));
     } else {
-      bad(line, "unknown keyword '" + std::string(keyword) + "'");
+      bad(line, "unknown keyword " + quote(keyword));
     }
   }
   if(!has_end) fail(filename, "bad PLY header: no 'end_header' line");
@@ -861,6 +927,21 @@ inline std::string truncated_message(const Ply_header_element& element, std::siz
          " rows, data end at row " + std::to_string(rows_found);
 }
 
+/// \brief `truncated_message()` for binary data: the incomplete row starts at byte
+/// `offset` of a file of `file_size` bytes.
+inline std::string truncated_message(const Ply_header_element& element, std::size_t rows_found,
+                                     std::uint64_t offset, std::uint64_t file_size)
+{
+  return truncated_message(element, rows_found) + " (byte offset " + std::to_string(offset) + ", file size " +
+         std::to_string(file_size) + ")";
+}
+
+/// \brief ` (byte offset <offset>)`, the place of an error in binary data.
+inline std::string at_byte_offset(std::uint64_t offset)
+{
+  return " (byte offset " + std::to_string(offset) + ")";
+}
+
 /// \brief Stores a decoded vertex value according to its role.
 inline void store_vertex_value(Point_cloud& cloud, std::size_t vertex, std::size_t role, double value)
 {
@@ -871,29 +952,44 @@ inline void store_vertex_value(Point_cloud& cloud, std::size_t vertex, std::size
 
 /// \brief Checks that the coordinates `point[0..2]` and, unless `normal` is null, the
 /// normal `normal[0..2]` are finite; the error message names the point as `<where>
-/// <position>`, e.g. `line 12` or `vertex 11`.
+/// <position><suffix>`, e.g. `line 12` or `vertex 11 (byte offset 296)`.
 inline void check_finite_values(const std::string& filename, const double* point, const double* normal,
-                                const char* where, std::uint64_t position)
+                                const char* where, std::uint64_t position, const char* suffix = "")
 {
   if(!(std::isfinite(point[0]) && std::isfinite(point[1]) && std::isfinite(point[2])))
-    fail(filename, std::string("non-finite coordinate at ") + where + " " + std::to_string(position));
+    fail(filename, std::string("non-finite coordinate at ") + where + " " + std::to_string(position) + suffix);
   if(normal != nullptr && !(std::isfinite(normal[0]) && std::isfinite(normal[1]) && std::isfinite(normal[2])))
-    fail(filename, std::string("non-finite normal at ") + where + " " + std::to_string(position));
+    fail(filename, std::string("non-finite normal at ") + where + " " + std::to_string(position) + suffix);
 }
 
 /// \brief Checks that point `vertex` has finite coordinates and normal; the error
-/// message names it as `<where> <position>`, e.g. `line 12` or `vertex 11`.
+/// message names it as `<where> <position><suffix>`, e.g. `line 12` or `vertex 11
+/// (byte offset 296)`.
 inline void check_finite_vertex(const std::string& filename, const Point_cloud& cloud,
-                                std::size_t vertex, const char* where, std::size_t position)
+                                std::size_t vertex, const char* where, std::size_t position,
+                                const char* suffix = "")
 {
   check_finite_values(filename, cloud.points[vertex].data(),
-                      cloud.has_normals() ? cloud.normals[vertex].data() : nullptr, where, position);
+                      cloud.has_normals() ? cloud.normals[vertex].data() : nullptr, where, position, suffix);
 }
 
-/// \brief Skips the binary data of `element` starting at `p`; returns the end of the data.
-inline const char* skip_binary_element(const std::string& filename, const Ply_header_element& element,
-                                       const char* p, const char* end, bool swap)
+/// \brief Returns `true` if point `vertex` of `cloud` has finite coordinates and normal.
+inline bool is_finite_vertex(const Point_cloud& cloud, std::size_t vertex)
 {
+  const std::array<double, 3>& p = cloud.points[vertex];
+  if(!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) return false;
+  if(!cloud.has_normals()) return true;
+  const std::array<double, 3>& n = cloud.normals[vertex];
+  return std::isfinite(n[0]) && std::isfinite(n[1]) && std::isfinite(n[2]);
+}
+
+/// \brief Skips the binary data of `element` starting at `p` in the file content
+/// `[file_begin, end)`; returns the end of the data.
+inline const char* skip_binary_element(const std::string& filename, const Ply_header_element& element,
+                                       const char* file_begin, const char* p, const char* end, bool swap)
+{
+  const std::uint64_t file_size = static_cast<std::uint64_t>(end - file_begin);
+  auto offset = [file_begin](const char* q) { return static_cast<std::uint64_t>(q - file_begin); };
   bool has_list = false;
   std::size_t row_size = 0;
   for(const Ply_header_property& property : element.properties) {
@@ -903,36 +999,42 @@ inline const char* skip_binary_element(const std::string& filename, const Ply_he
   if(!has_list) {
     if(row_size == 0) return p;
     const std::size_t available = static_cast<std::size_t>(end - p) / row_size;
-    if(available < element.count) fail(filename, truncated_message(element, available));
+    if(available < element.count)
+      fail(filename, truncated_message(element, available, offset(p + available * row_size), file_size));
     return p + element.count * row_size;
   }
   for(std::size_t row = 0; row < element.count; ++row) {
+    const char* const row_begin = p;
     for(const Ply_header_property& property : element.properties) {
       if(!property.is_list) {
         const std::size_t size = ply_scalar_type_size(property.type);
-        if(static_cast<std::size_t>(end - p) < size) fail(filename, truncated_message(element, row));
+        if(static_cast<std::size_t>(end - p) < size)
+          fail(filename, truncated_message(element, row, offset(row_begin), file_size));
         p += size;
         continue;
       }
       const std::size_t count_size = ply_scalar_type_size(property.count_type);
-      if(static_cast<std::size_t>(end - p) < count_size) fail(filename, truncated_message(element, row));
+      if(static_cast<std::size_t>(end - p) < count_size)
+        fail(filename, truncated_message(element, row, offset(row_begin), file_size));
       const double count = load_scalar(p, property.count_type, swap);
-      p += count_size;
       if(count < 0)
-        fail(filename, "negative list length in element '" + element.name + "' at row " + std::to_string(row));
+        fail(filename, "negative list length in element '" + element.name + "' at row " + std::to_string(row) +
+                         at_byte_offset(offset(p)));
+      p += count_size;
       const std::size_t item_size = ply_scalar_type_size(property.type);
       if(static_cast<std::size_t>(end - p) / item_size < static_cast<std::size_t>(count))
-        fail(filename, truncated_message(element, row));
+        fail(filename, truncated_message(element, row, offset(row_begin), file_size));
       p += static_cast<std::size_t>(count) * item_size;
     }
   }
   return p;
 }
 
-/// \brief Decodes the binary vertex data starting at `p`; returns the end of the data.
+/// \brief Decodes the binary vertex data starting at `p` in the file content
+/// `[file_begin, end)`; returns the end of the data.
 inline const char* read_binary_vertices(const std::string& filename, const Ply_header_element& element,
-                                        const std::vector<std::size_t>& roles, const char* p,
-                                        const char* end, bool swap, Point_cloud& cloud)
+                                        const std::vector<std::size_t>& roles, const char* file_begin,
+                                        const char* p, const char* end, bool swap, Point_cloud& cloud)
 {
   std::vector<std::size_t> offsets;
   std::size_t row_size = 0;
@@ -941,7 +1043,9 @@ inline const char* read_binary_vertices(const std::string& filename, const Ply_h
     row_size += ply_scalar_type_size(property.type);
   }
   const std::size_t available = static_cast<std::size_t>(end - p) / row_size;
-  if(available < element.count) fail(filename, truncated_message(element, available));
+  if(available < element.count)
+    fail(filename, truncated_message(element, available, static_cast<std::uint64_t>(p + available * row_size - file_begin),
+                                     static_cast<std::uint64_t>(end - file_begin)));
 
   const std::size_t n = element.count;
   cloud.points.resize(n);
@@ -952,7 +1056,9 @@ inline const char* read_binary_vertices(const std::string& filename, const Ply_h
   for(std::size_t i = 0; i < n; ++i, p += row_size) {
     for(std::size_t j = 0; j < property_count; ++j)
       store_vertex_value(cloud, i, roles[j], load_scalar(p + offsets[j], element.properties[j].type, swap));
-    check_finite_vertex(filename, cloud, i, "vertex", i);
+    if(!is_finite_vertex(cloud, i))
+      check_finite_vertex(filename, cloud, i, "vertex", i,
+                          at_byte_offset(static_cast<std::uint64_t>(p - file_begin)).c_str());
   }
   return p;
 }
@@ -997,9 +1103,9 @@ inline void parse_ascii_row(const std::string& filename, const Ply_header_elemen
     const Ply_header_property& property = element.properties[j];
     const Parse_status status = parse_ply_ascii_value(q, token_end, property.type, values[j]);
     if(status == Parse_status::INVALID)
-      fail(filename, "non-numeric token " + quoted(q, token_end) + at_line());
+      fail(filename, "non-numeric token " + quote(q, token_end) + at_line());
     if(status == Parse_status::OUT_OF_RANGE)
-      fail(filename, "value " + quoted(q, token_end) + " out of range for property '" + property.name +
+      fail(filename, "value " + quote(q, token_end) + " out of range for property '" + property.name +
                        "' of type " + ply_scalar_type_name(property.type) + at_line());
     q = token_end;
   }
@@ -1346,7 +1452,7 @@ inline Xyz_error parse_xyz_values(const char* q, const char* const eol, std::arr
       }
       const char* token_end = q;
       while(token_end != eol && !is_blank(*token_end)) ++token_end;
-      error_token = quoted(q, token_end);
+      error_token = quote(q, token_end);
       const bool out_of_range = result.ec == std::errc::result_out_of_range && result.ptr == token_end;
       return out_of_range ? Xyz_error::OUT_OF_RANGE : Xyz_error::NON_NUMERIC;
     }
@@ -1514,55 +1620,30 @@ inline int effective_precision(int requested, int digits)
 /// \brief Number of points formatted at once by one thread of `write_xyz()`.
 constexpr std::size_t xyz_block_points = 16384;
 
-} // namespace internal
-
-/// \brief Reads a text point cloud (`.xyz` or `.pwn` layout) from `filename`, whatever
-/// its extension.
-///
-/// Each line holds `x y z` or `x y z nx ny nz`, separated by blanks; every data line
-/// must have the same number of values. Blank lines and lines starting with `#` are
-/// skipped. Normals may be zero but coordinates and normals must be finite. The largest
-/// numbers of significant digits of the coordinates and of the normals are recorded in
-/// `point_digits` and `normal_digits`. A large file is parsed by several threads (see
-/// `Read_options::number_of_threads`), with the same result.
-/// \throws Io_error on any error (unreadable file, non-numeric token, wrong column count,
-/// non-finite value), naming the file and the line; with several errors, the first one
-/// in the file.
-inline Point_cloud read_xyz(const std::string& filename, const Read_options& options = Read_options())
+/// \brief The cloud of the `.xyz`/`.pwn` text `[begin, end)`, as `read_xyz()` reads
+/// it from the file `filename` (named in the error messages only).
+inline Point_cloud parse_xyz_text(const std::string& filename, const char* begin, const char* end,
+                                  const Read_options& options)
 {
-  using namespace internal;
-  const File_content content = read_file_content(filename);
-  const unsigned int threads = text_thread_count(options.number_of_threads, content.size);
-  const std::vector<const char*> bounds = split_at_lines(content.begin(), content.end(), threads);
+  const unsigned int threads = text_thread_count(options.number_of_threads, static_cast<std::size_t>(end - begin));
+  const std::vector<const char*> bounds = split_at_lines(begin, end, threads);
   std::vector<Xyz_chunk> chunks(threads);
   run_concurrently(threads,
                    [&bounds, &chunks](std::size_t i) { parse_xyz_chunk(bounds[i], bounds[i + 1], chunks[i]); });
   return merge_xyz_chunks(filename, chunks);
 }
 
-/// \brief Reads a PLY point cloud from `filename`, whatever its extension.
-///
-/// Accepts the `ascii`, `binary_little_endian` and `binary_big_endian` encodings (version
-/// 1.0). The `vertex` element must have scalar properties `x y z` and may have `nx ny nz`
-/// (all three or none), of any scalar type. Its other scalar properties are stored in
-/// `extra_properties`/`extra_values`, and the types of `x y z nx ny nz` in `point_types`
-/// and `normal_types`. Other elements (e.g. `face`, with list properties), before or
-/// after `vertex`, are skipped and their data are not kept. In an ASCII file each
-/// element row must be on its own line; rows of other elements are not validated.
-/// \throws Io_error on any error (unreadable file, bad header, truncated data,
-/// non-numeric token, non-finite coordinate or normal), naming the file and the line
-/// (ASCII) or the vertex index (binary).
-inline Point_cloud read_ply(const std::string& filename)
+/// \brief The cloud of the PLY data `[begin, end)`, as `read_ply()` reads it from the
+/// file `filename` (named in the error messages only).
+inline Point_cloud parse_ply_data(const std::string& filename, const char* begin, const char* end)
 {
-  using namespace internal;
-  const File_content content = read_file_content(filename);
-  const Ply_header header = parse_ply_header(filename, content.begin(), content.end());
+  const Ply_header header = parse_ply_header(filename, begin, end);
   Point_cloud cloud;
   const std::vector<std::size_t> roles =
     assign_vertex_roles(filename, header.elements[header.vertex_element], cloud);
 
   if(header.format == Ply_format::ASCII) {
-    Line_reader reader{header.data_begin, content.end(), header.line_count};
+    Line_reader reader{header.data_begin, end, header.line_count};
     for(std::size_t e = 0; e < header.elements.size(); ++e) {
       const Ply_header_element& element = header.elements[e];
       if(e == header.vertex_element) {
@@ -1583,11 +1664,53 @@ inline Point_cloud read_ply(const std::string& filename)
   for(std::size_t e = 0; e < header.elements.size(); ++e) {
     const Ply_header_element& element = header.elements[e];
     if(e == header.vertex_element)
-      p = read_binary_vertices(filename, element, roles, p, content.end(), swap, cloud);
+      p = read_binary_vertices(filename, element, roles, begin, p, end, swap, cloud);
     else
-      p = skip_binary_element(filename, element, p, content.end(), swap);
+      p = skip_binary_element(filename, element, begin, p, end, swap);
   }
   return cloud;
+}
+
+} // namespace internal
+
+/// \brief Reads a text point cloud (`.xyz` or `.pwn` layout) from `filename`, whatever
+/// its extension.
+///
+/// Each line holds `x y z` or `x y z nx ny nz`, separated by blanks; every data line
+/// must have the same number of values. Blank lines and lines starting with `#` are
+/// skipped. Normals may be zero but coordinates and normals must be finite. The largest
+/// numbers of significant digits of the coordinates and of the normals are recorded in
+/// `point_digits` and `normal_digits`. A large file is parsed by several threads (see
+/// `Read_options::number_of_threads`), with the same result.
+/// \throws Io_error on any error (unreadable file, non-numeric token, wrong column count,
+/// non-finite value), naming the file and the line; with several errors, the first one
+/// in the file.
+inline Point_cloud read_xyz(const std::string& filename, const Read_options& options = Read_options())
+{
+  const internal::File_content content = internal::read_file_content(filename);
+  return internal::parse_xyz_text(filename, content.begin(), content.end(), options);
+}
+
+/// \brief Reads a PLY point cloud from `filename`, whatever its extension.
+///
+/// Accepts the `ascii`, `binary_little_endian` and `binary_big_endian` encodings (version
+/// 1.0). The `vertex` element must have scalar properties `x y z` and may have `nx ny nz`
+/// (all three or none), of any scalar type. Its other scalar properties are stored in
+/// `extra_properties`/`extra_values`, and the types of `x y z nx ny nz` in `point_types`
+/// and `normal_types`. Other elements (e.g. `face`, with list properties), before or
+/// after `vertex`, are skipped and their data are not kept. In an ASCII file each
+/// element row must be on its own line; rows of other elements are not validated.
+/// Coordinates and normals must be finite (a NaN or an infinity is an error); other
+/// properties may hold any value of their type. An ASCII `float` value is read as the
+/// nearest `float`; an integer value may be written as a real (`255.0`).
+/// \throws Io_error on any error (unreadable or empty file, bad header, truncated data,
+/// non-numeric token, value out of the range of its type, non-finite coordinate or
+/// normal), naming the file and the line (ASCII) or the vertex or row index and the
+/// byte offset (binary).
+inline Point_cloud read_ply(const std::string& filename)
+{
+  const internal::File_content content = internal::read_file_content(filename);
+  return internal::parse_ply_data(filename, content.begin(), content.end());
 }
 
 /// \brief Reads a point cloud from `filename`, choosing the format from the extension
@@ -1676,8 +1799,9 @@ inline void write_xyz(const std::string& filename, const Point_cloud& cloud,
 /// `binary_little_endian` if `options.binary`, `ascii` otherwise.
 ///
 /// The single `vertex` element has the properties `x y z` with types `point_types`,
-/// then `nx ny nz` (if the cloud has normals) with types `normal_types` (`float` if they
-/// are integer types), then every extra property with its name and type, in order.
+/// then `nx ny nz` (if the cloud has normals) with types `normal_types` (`float` for
+/// 8- and 16-bit integer types, `double` for 32-bit ones: see `Point_cloud::normal_types`),
+/// then every extra property with its name and type, in order.
 /// Types are written with their classic names (`uchar`, `float`...). ASCII values are
 /// written with the shortest text that reads back exactly, so that extra values
 /// round-trip exactly in both encodings. The file is written atomically.
@@ -1704,7 +1828,7 @@ inline void write_ply(const std::string& filename, const Point_cloud& cloud,
   for(std::size_t r = 0; r < 3; ++r) columns.push_back({r, cloud.point_types[r], &fixed_names[r]});
   if(cloud.has_normals())
     for(std::size_t r = 0; r < 3; ++r) {
-      const Ply_scalar_type type = is_floating(cloud.normal_types[r]) ? cloud.normal_types[r] : Ply_scalar_type::FLOAT32;
+      const Ply_scalar_type type = written_normal_type(cloud.normal_types[r]);
       columns.push_back({3 + r, type, &fixed_names[3 + r]});
     }
   for(std::size_t k = 0; k < extra_count; ++k)
@@ -1768,6 +1892,8 @@ inline void write_point_cloud(const std::string& filename, const Point_cloud& cl
   internal::fail(filename, "unknown point cloud file extension '" + extension +
                              "' (expected .xyz, .pwn or .ply)");
 }
+
+/// @}
 
 } // namespace IO
 } // namespace Normal_orientation

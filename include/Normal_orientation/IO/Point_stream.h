@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <array>
 #include <cerrno>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -39,6 +40,9 @@
 
 namespace Normal_orientation {
 namespace IO {
+
+/// \addtogroup PkgNormalOrientationIO
+/// @{
 
 namespace internal {
 
@@ -267,8 +271,16 @@ class Point_stream_reader
 public:
   /// Default buffer size in bytes (1 MiB).
   static constexpr std::size_t default_buffer_size = std::size_t(1) << 20;
-  /// Smallest buffer size in bytes; smaller requests are raised to it.
-  static constexpr std::size_t minimum_buffer_size = 4096;
+  /// Smallest buffer size in bytes; smaller requests are raised to it. 4096 unless the
+  /// macro `NORMAL_ORIENTATION_MINIMUM_STREAM_BUFFER_SIZE` is defined (the fuzz targets
+  /// set it to 1, so that small inputs exercise the refills of the buffer).
+  static constexpr std::size_t minimum_buffer_size =
+#ifdef NORMAL_ORIENTATION_MINIMUM_STREAM_BUFFER_SIZE
+    std::size_t(NORMAL_ORIENTATION_MINIMUM_STREAM_BUFFER_SIZE);
+#else
+    4096;
+#endif
+  static_assert(minimum_buffer_size >= 1, "the reading buffer needs at least one byte");
 
   /// \brief Opens `filename` and reads its header (for a `.xyz`/`.pwn` file, up to its
   /// first data line, to know whether it has normals), with a reading buffer of
@@ -488,9 +500,11 @@ private:
     input_->reserve(row_size_);
     // Check the size of the vertex data and, if the rows of the following elements have
     // a fixed size, of the whole data.
-    const std::uint64_t remaining = input_->file_size() - data_offset_;
+    const std::uint64_t file_size = input_->file_size();
+    const std::uint64_t remaining = file_size - data_offset_;
     if(remaining / row_size_ < vertex.count)
-      fail(filename_, truncated_message(vertex, static_cast<std::size_t>(remaining / row_size_)));
+      fail(filename_, truncated_message(vertex, static_cast<std::size_t>(remaining / row_size_),
+                                        data_offset_ + remaining / row_size_ * row_size_, file_size));
     std::uint64_t end = data_offset_ + static_cast<std::uint64_t>(vertex.count) * row_size_;
     for(std::size_t e = vertex_element_ + 1; e < elements_.size(); ++e) {
       std::uint64_t size = 0;
@@ -499,9 +513,10 @@ private:
         size += ply_scalar_type_size(property.type);
       }
       if(size == 0) continue;
-      const std::uint64_t left = input_->file_size() - end;
+      const std::uint64_t left = file_size - end;
       if(left / size < elements_[e].count)
-        fail(filename_, truncated_message(elements_[e], static_cast<std::size_t>(left / size)));
+        fail(filename_, truncated_message(elements_[e], static_cast<std::size_t>(left / size), end + left / size * size,
+                                          file_size));
       end += size * elements_[e].count;
     }
     check_no_trailing_data(end);
@@ -538,26 +553,32 @@ private:
     }
     if(!has_list) {
       if(row_size == 0) return;
-      const std::uint64_t left = input_->file_size() - input_->position();
+      const std::uint64_t file_size = input_->file_size();
+      const std::uint64_t left = file_size - input_->position();
       if(left / row_size < element.count)
-        fail(filename_, truncated_message(element, static_cast<std::size_t>(left / row_size)));
+        fail(filename_, truncated_message(element, static_cast<std::size_t>(left / row_size),
+                                          input_->position() + left / row_size * row_size, file_size));
       input_->skip(row_size * element.count);
       return;
     }
+    const std::uint64_t file_size = input_->file_size();
     for(std::size_t row = 0; row < element.count; ++row) {
+      const std::uint64_t row_begin = input_->position();
       for(const Ply_header_property& property : element.properties) {
         if(!property.is_list) {
-          if(!input_->skip(ply_scalar_type_size(property.type))) fail(filename_, truncated_message(element, row));
+          if(!input_->skip(ply_scalar_type_size(property.type)))
+            fail(filename_, truncated_message(element, row, row_begin, file_size));
           continue;
         }
         const std::size_t count_size = ply_scalar_type_size(property.count_type);
-        if(input_->fill(count_size) < count_size) fail(filename_, truncated_message(element, row));
+        if(input_->fill(count_size) < count_size) fail(filename_, truncated_message(element, row, row_begin, file_size));
         const double count = load_scalar(input_->data(), property.count_type, swap_);
-        input_->consume(count_size);
         if(count < 0)
-          fail(filename_, "negative list length in element '" + element.name + "' at row " + std::to_string(row));
+          fail(filename_, "negative list length in element '" + element.name + "' at row " + std::to_string(row) +
+                            at_byte_offset(input_->position()));
+        input_->consume(count_size);
         if(!input_->skip(static_cast<std::uint64_t>(count) * ply_scalar_type_size(property.type)))
-          fail(filename_, truncated_message(element, row));
+          fail(filename_, truncated_message(element, row, row_begin, file_size));
       }
     }
   }
@@ -616,7 +637,8 @@ private:
     std::size_t count = 0;
     while(count < maximum && next_index_ < expected_count_) {
       if(input_->fill(row_size_) < row_size_)
-        fail(filename_, truncated_message(elements_[vertex_element_], static_cast<std::size_t>(next_index_)));
+        fail(filename_, truncated_message(elements_[vertex_element_], static_cast<std::size_t>(next_index_),
+                                          input_->position(), input_->file_size()));
       const std::size_t rows = static_cast<std::size_t>(std::min<std::uint64_t>(
         {input_->available() / row_size_, maximum - count, expected_count_ - next_index_}));
       const char* p = input_->data();
@@ -627,8 +649,11 @@ private:
           if(field.role < 3) record.position[field.role] = value;
           else record.normal[field.role - 3] = value;
         }
-        check_finite_values(filename_, record.position, has_normals_ ? record.normal : nullptr, "vertex",
-                            next_index_);
+        const double* const normal = has_normals_ ? record.normal : nullptr;
+        if(!(std::isfinite(record.position[0]) && std::isfinite(record.position[1]) && std::isfinite(record.position[2]) &&
+             (normal == nullptr || (std::isfinite(normal[0]) && std::isfinite(normal[1]) && std::isfinite(normal[2])))))
+          check_finite_values(filename_, record.position, normal, "vertex", next_index_,
+                              at_byte_offset(input_->position()).c_str());
         record.index = next_index_++;
         chunk.push_back(record);
         input_->consume(row_size_);
@@ -796,6 +821,8 @@ private:
   std::uint64_t count_offset_ = 0; // PLY: byte offset of the vertex count
   bool committed_ = false;
 };
+
+/// @}
 
 } // namespace IO
 } // namespace Normal_orientation
