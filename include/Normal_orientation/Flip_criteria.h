@@ -121,7 +121,8 @@ struct Xie_criterion
 /// low curvature between neighbours and handles creases better than
 /// Hoppe's criterion; like Hoppe's, it says "flip" across a slab thinner
 /// than the point spacing, where Xie's criterion is the one to use.
-/// See `internal::konig_phi()` for the construction and its guarantees.
+/// The construction and its guarantees are described with
+/// `internal::konig_phi()`, in `internal/Konig_curves.h`.
 /// \cgalModels `FlipCriterion`
 struct Konig_criterion
 {

@@ -273,10 +273,14 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
 /// \tparam ConcurrencyTag `CGAL::Parallel_tag` (kd-tree build, queries and
 ///         weights in parallel with TBB) or `CGAL::Sequential_tag`; the
 ///         graph is identical either way.
+/// \tparam Kernel a \cgal kernel, whose `Point_3` and `Vector_3` the points and
+///         normals are
+/// \tparam FlipCriterion a model of `FlipCriterion`
+///
 /// Queries run in the order of `points`: points in a spatially coherent
-/// order (a scan order, or `internal::morton_order()`, which
-/// `orient_normals()` applies) make the construction several times faster
-/// than points in random order.
+/// order (a scan order, or the Morton order that `orient_normals()`
+/// applies) make the construction several times faster than points in
+/// random order.
 ///
 /// \param points the positions
 /// \param normals the normals, same size (any length; zero allowed)
@@ -285,7 +289,10 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
 /// \param criterion a model of `FlipCriterion`
 /// \param graph receives the graph
 /// \param progress receives progress in [0, 1] and may interrupt the run
+///        (`internal::Progress()` reports nothing; `internal::Progress(callback)`
+///        calls a `std::function<bool(double)>`, whose `false` throws `Interrupted`)
 /// \pre points and normals are finite (checked by `orient_normals()`)
+/// \return what was measured and decided: the k and r used, the number of edges, the times
 template <typename ConcurrencyTag, typename Kernel, typename FlipCriterion>
 Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Point_3>& points,
                                            const std::vector<typename Kernel::Vector_3>& normals,

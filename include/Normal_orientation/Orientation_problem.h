@@ -37,6 +37,10 @@ typedef signed char Label;
 /// \ingroup PkgNormalOrientationProblem
 /// The penalty of one edge of weight `w` whose end labels are `l_i`, `l_j`
 /// (paper eq. 2): |w| when (w >= 0) xor (l_i == l_j), else 0.
+/// \param w the signed weight of the edge
+/// \param l_i the label (+1 or -1) of one end
+/// \param l_j the label (+1 or -1) of the other end
+/// \return the penalty, >= 0
 inline double edge_energy(double w, int l_i, int l_j)
 {
   const bool same = (l_i == l_j);
@@ -50,6 +54,10 @@ inline double edge_energy(double w, int l_i, int l_j)
 /// vertex property map with values +1/-1) on `g` with the signed edge
 /// weights `weight` (a readable edge property map).
 /// \tparam Graph a model of `EdgeListGraph`
+/// \param g the graph: one pairwise term per edge
+/// \param weight the signed edge weights
+/// \param labels the label (+1 or -1) of every vertex
+/// \return the sum of `edge_energy()` over the edges
 template <typename Graph, typename WeightMap, typename LabelMap>
 double energy(const Graph& g, WeightMap weight, LabelMap labels)
 {
@@ -73,6 +81,11 @@ double energy(const Graph& g, WeightMap weight, LabelMap labels)
 ///         `first` (the cost of label +1) and `second` (the cost of label
 ///         -1) convertible to `double`, such as `std::pair<double, double>`
 /// \tparam LabelMap a readable vertex property map with values +1/-1
+/// \param g the graph: one pairwise term per edge
+/// \param weight the signed edge weights
+/// \param unary the unary costs of every vertex
+/// \param labels the label (+1 or -1) of every vertex
+/// \return the energy, edges and unary terms together
 template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
 double energy(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels)
 {
@@ -93,6 +106,11 @@ double energy(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels)
 /// vertex `i`.  Returns the number of components.
 /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
 ///         internal `vertex_index` map
+/// \tparam WeightMap a readable edge property map with a floating value
+/// \param g the graph
+/// \param weight the signed edge weights (only whether they are zero matters)
+/// \param component receives the component of every vertex, by vertex index
+/// \return the number of components
 template <typename Graph, typename WeightMap>
 std::size_t connected_components(const Graph& g, WeightMap weight, std::vector<std::uint32_t>& component)
 {

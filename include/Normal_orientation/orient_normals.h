@@ -145,7 +145,8 @@ void run_with_threads(int threads, const F& f)
 ///   iterator; its value type is the key of the point and normal maps.
 ///
 /// \param points the input points, with unoriented normals
-/// \param np optional named parameters among:
+/// \param np optional named parameters among the following ones (described
+///   on the page \ref NormalOrientationNamedParameters):
 /// \cgalNamedParamsBegin
 ///   \cgalParamNBegin{point_map}
 ///     \cgalParamDescription{a property map associating points to the elements of `points`}

@@ -10,7 +10,9 @@
 /// pack built with `CGAL::parameters::point_map(pm).normal_map(nm)` is accepted
 /// as is.  CGAL's list of names is closed, so the package's own names
 /// (`number_of_neighbors`, `flip_criterion`, `solver`, `component_sign`,
-/// `number_of_threads`) live in `Normal_orientation::parameters`, whose packs
+/// `number_of_threads`, `orientation_prior_map`; all the names are described
+/// on the page \ref NormalOrientationNamedParameters) live in
+/// `Normal_orientation::parameters`, whose packs
 /// are CGAL packs (derived from `CGAL::Named_function_parameters`) that also
 /// offer every CGAL name, so both kinds of names chain freely:
 /// \code
@@ -44,6 +46,7 @@ NORMAL_ORIENTATION_NAMED_PARAMETERS(NORMAL_ORIENTATION_DECLARE_TAG)
 
 } // namespace internal_np
 
+/// \ingroup PkgNormalOrientationParameters
 /// A named-parameter pack: a `CGAL::Named_function_parameters` that also has
 /// the package's own names as member functions, and whose CGAL member
 /// functions return packs of this type again.
@@ -86,9 +89,11 @@ struct Named_function_parameters : CGAL::Named_function_parameters<T, Tag, Base>
 /// Free functions that start a named-parameter pack.
 namespace parameters {
 
+/// \ingroup PkgNormalOrientationParameters
 /// the empty pack, the default of every function of the package
 typedef Named_function_parameters<bool, CGAL::internal_np::all_default_t> Default_named_parameters;
 
+/// \ingroup PkgNormalOrientationParameters
 /// returns the empty pack
 inline Default_named_parameters default_values() { return Default_named_parameters(); }
 
@@ -130,6 +135,7 @@ auto extend_impl(const CGAL::Named_function_parameters<T, Tag, Base>& np)
 } // namespace internal
 /// \endcond
 
+/// \ingroup PkgNormalOrientationParameters
 /// Converts a pack of CGAL's (for example `CGAL::Point_set_3::parameters()`)
 /// into a pack of this package, so that the package's own names can be
 /// chained to it.

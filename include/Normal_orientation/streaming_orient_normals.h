@@ -78,6 +78,8 @@ enum class Streaming_stage
 /// \ingroup PkgNormalOrientationStreaming
 /// The lower-case name of `stage` ("scan", "radius", "sort", "sweep",
 /// "solve", "sign", "output", "components").
+/// \param stage the stage
+/// \return a string literal
 inline const char* streaming_stage_name(Streaming_stage stage)
 {
   switch (stage) {
@@ -219,8 +221,12 @@ struct Streaming_result
   /// computes; `components`: the component files)
   struct Seconds
   {
+    /// @{
+    /// wall-clock seconds of the stage of that name (see `Streaming_stage`;
+    /// `total`: the whole call)
     double frame = 0, radius = 0, sort = 0, sweep = 0, solve = 0, sign = 0, output = 0, components = 0, total = 0;
-  } seconds;
+    /// @}
+  } seconds; ///< seconds per stage
 };
 
 /// \cond SKIP_IN_MANUAL
@@ -426,6 +432,23 @@ private:
 ///        source, the sort and the temporary files (also std::system_error);
 ///        `IO::Io_error` when a component file cannot be written;
 ///        `Interrupted` when the callback returns false
+///
+/// \tparam ConcurrencyTag `CGAL::Parallel_tag`, `CGAL::Sequential_tag` or
+///         `CGAL::Parallel_if_available_tag` (the default); the result does
+///         not depend on it
+/// \tparam Kernel the \cgal kernel of the computations (the records hold doubles)
+/// \tparam Source a model of `PointRecordSource`
+/// \tparam Sink a model of `PointRecordSink`
+/// \tparam FlipCriterion a model of `FlipCriterion`
+/// \tparam Solver a model of `OrientationSolver`, run without unary terms on
+///         the segment graph
+/// \param source the points, read twice
+/// \param sink receives every point kept, oriented, in the sweep order
+/// \param options k, r, the segmentation, the sort, the presorted axis, the
+///        component files, the progress callback
+/// \param criterion the flip criterion
+/// \param solver the solver of the segment graph
+/// \return the figures of the run
 template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag,
           typename Kernel = CGAL::Exact_predicates_inexact_constructions_kernel, typename Source, typename Sink,
           typename FlipCriterion = Hoppe_criterion, typename Solver = Qpbo_i_solver>
@@ -939,6 +962,12 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
 /// run fails, the output's last step included.
 /// \throw IO::Io_error for unreadable, malformed or unwritable files, or an
 ///        input without normals; see `streaming_orient_normals()`
+/// \tparam ConcurrencyTag, Kernel, FlipCriterion, Solver as for `streaming_orient_normals()`
+/// \param input the file to orient (.xyz/.pwn with normals, or .ply with normals)
+/// \param output the file written (.xyz, .pwn or .ply)
+/// \param options, criterion, solver as for `streaming_orient_normals()`
+/// \param write_options how `output` is written (binary or ascii PLY, ...)
+/// \return the figures of the run
 template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag,
           typename Kernel = CGAL::Exact_predicates_inexact_constructions_kernel,
           typename FlipCriterion = Hoppe_criterion, typename Solver = Qpbo_i_solver>

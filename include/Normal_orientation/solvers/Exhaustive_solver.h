@@ -92,6 +92,10 @@ public:
   /// \throw std::length_error if a connected component of the edges of
   ///        non-zero weight has more than `maximum_vertices` vertices
   /// \throw std::invalid_argument if a weight is not finite
+  /// \param g the graph: one pairwise term per edge
+  /// \param weight the signed edge weights
+  /// \param labels receives the label (+1 or -1) of every vertex
+  /// \return the report of the solve
   template <typename Graph, typename WeightMap, typename LabelMap>
   Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
   {
@@ -114,6 +118,11 @@ public:
   /// \throw std::length_error if a connected component of the edges of
   ///        non-zero weight has more than `maximum_vertices` vertices
   /// \throw std::invalid_argument if a weight or a unary cost is not finite
+  /// \param g the graph: one pairwise term per edge
+  /// \param weight the signed edge weights
+  /// \param unary the costs of the labels +1 (`first`) and -1 (`second`) of every vertex
+  /// \param labels receives the label (+1 or -1) of every vertex
+  /// \return the report of the solve (its energy includes the unary costs)
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
   {

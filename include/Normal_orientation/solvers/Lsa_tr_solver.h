@@ -146,6 +146,10 @@ public:
   ///         internal `vertex_index` map (vertex indices 0 ... n-1)
   /// \tparam WeightMap a readable edge property map with a floating value
   /// \tparam LabelMap a writable vertex property map accepting `Label`
+  /// \param g the graph: one pairwise term per edge
+  /// \param weight the signed edge weights
+  /// \param labels receives the label (+1 or -1) of every vertex
+  /// \return the report of the solve
   template <typename Graph, typename WeightMap, typename LabelMap>
   Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
   {
@@ -169,6 +173,11 @@ public:
   ///         -1) convertible to `double`, such as `std::pair<double, double>`
   /// \tparam LabelMap a writable vertex property map accepting `Label`
   /// \throw std::invalid_argument if a unary cost is not finite
+  /// \param g the graph: one pairwise term per edge
+  /// \param weight the signed edge weights
+  /// \param unary the costs of the labels +1 (`first`) and -1 (`second`) of every vertex
+  /// \param labels receives the label (+1 or -1) of every vertex
+  /// \return the report of the solve (its energy includes the unary costs)
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
   {

@@ -89,7 +89,8 @@ public:
   /// between fixes for a bounded cost of maximum_solves * O(V + E) per order.
   unsigned int maximum_solves = 64;
 
-  /// the solver with `orders` random orders seeded by `seed`
+  /// the solver with `number_of_orders` random orders seeded by `random_seed`
+  /// (the members `orders` and `seed`)
   explicit Qpbo_i_solver(unsigned int number_of_orders = 3, unsigned long random_seed = 0)
     : orders(number_of_orders), seed(random_seed)
   {}
@@ -126,6 +127,10 @@ public:
   /// \tparam WeightMap a readable edge property map with a floating value
   /// \tparam LabelMap a writable vertex property map accepting `Label`
   /// \throw std::invalid_argument if a weight is not finite
+  /// \param g the graph: one pairwise term per edge
+  /// \param weight the signed edge weights
+  /// \param labels receives the label (+1 or -1) of every vertex
+  /// \return the report of the solve
   template <typename Graph, typename WeightMap, typename LabelMap>
   Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
   {
@@ -138,6 +143,11 @@ public:
   /// costs of the labels +1 and -1.  A cost larger than the sum of all the
   /// |weights| makes the label of its vertex a hard constraint.
   /// \throw std::invalid_argument if a weight or a unary cost is not finite
+  /// \param g the graph: one pairwise term per edge
+  /// \param weight the signed edge weights
+  /// \param unary the costs of the labels +1 (`first`) and -1 (`second`) of every vertex
+  /// \param labels receives the label (+1 or -1) of every vertex
+  /// \return the report of the solve (its energy includes the unary costs)
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
   {

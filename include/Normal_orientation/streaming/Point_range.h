@@ -112,8 +112,8 @@ private:
 /// \ingroup PkgNormalOrientationStreaming
 /// The source of the points of `points` (a range of a CGAL point set
 /// processing style: `CGAL::Point_set_3`, a vector of pairs...), with the
-/// named parameters `point_map` and `normal_map` (required), and
-/// `checked_axis` -1 (default), 0, 1 or 2 (see `Point_range_source`).
+/// named parameters `point_map` and `normal_map` (required), and the
+/// argument `checked_axis`: -1 (default), 0, 1 or 2 (see `Point_range_source`).
 template <typename PointRange, typename NamedParameters = parameters::Default_named_parameters>
 Point_range_source<typename PointRange::const_iterator,
                    typename CGAL::Point_set_processing_3_np_helper<PointRange, NamedParameters>::Const_point_map,

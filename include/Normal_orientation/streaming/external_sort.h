@@ -354,10 +354,10 @@ inline void write_all(int fd, const void* data, std::size_t bytes, const std::st
     if (n < 0) {
       if (errno == EINTR)
         continue;
-      throw std::system_error(errno, std::generic_category(), "external sort: cannot write " + path);
+      throw std::system_error(errno, std::generic_category(), "cannot write the temporary file " + path);
     }
     if (n == 0)
-      throw std::system_error(ENOSPC, std::generic_category(), "external sort: cannot write " + path);
+      throw std::system_error(ENOSPC, std::generic_category(), "cannot write the temporary file " + path);
     p += n;
     bytes -= std::size_t(n);
   }

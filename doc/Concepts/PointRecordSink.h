@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Documentation only: the concept PointRecordSink (not compiled, not installed).
+
+/*!
+\ingroup PkgNormalOrientationConcepts
+\cgalConcept
+\headerfile Point_record.h <Normal_orientation/streaming/Point_record.h>
+
+Where `Normal_orientation::streaming_orient_normals()` hands the oriented points: a
+function object called once per point kept, in the sweep order, from the calling thread,
+with the record of the point whose normal has its final sign (only the sign differs from
+the input's).  `record.index` is the point's index in the input, so a sink can write the
+normal back into the user's own container (`Normal_orientation::streaming::Normal_writer`)
+or append the record to a file (`Normal_orientation::streaming_orient_files()` uses a
+`Normal_orientation::IO::Point_stream_writer`).
+
+\cgalHasModelsBegin
+\cgalHasModels{Normal_orientation::streaming::Normal_writer}
+\cgalHasModels{any function object such as a lambda, e.g. one calling Normal_orientation::IO::Point_stream_writer::write()}
+\cgalHasModelsEnd
+
+\sa `PointRecordSource`
+*/
+class PointRecordSink
+{
+public:
+  /// receives one oriented point
+  void operator()(const Normal_orientation::streaming::Point_record& record);
+};
