@@ -18,6 +18,10 @@
 #include <CGAL/jet_estimate_normals.h>
 #include <CGAL/pca_estimate_normals.h>
 
+#ifdef CGAL_LINKED_WITH_TBB
+#include <tbb/global_control.h>
+#endif
+
 #include <unistd.h>
 
 #include <chrono>
@@ -27,6 +31,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -128,7 +133,8 @@ const char* usage_text =
   "                       every solver weighs against the edges (default 0: none)\n"
   "  --normals NAME       estimator when IN has no normals: jet (default), pca\n"
   "  --normal-k N         neighbours of the normal estimator (default 18)\n"
-  "  --threads N          threads (default: all cores); results do not depend on it\n"
+  "  --threads N          at most N threads (default, or 0: all cores); the output\n"
+  "                       does not depend on N (the same bytes)\n"
   "  --seed S             random seed of randomised solvers (default 0)\n"
   "  --stream             out of core, for clouds larger than memory: sort along the\n"
   "                       principal axis (temporary files in TMPDIR), sweep, segment,\n"
@@ -228,8 +234,8 @@ Options parse_options(int argc, char** argv)
       o.normal_k = unsigned(k);
     } else if (a == "--threads") {
       const long t = parse_number<long>(a, value());
-      if (t < 1 || t > 1024)
-        throw Usage_error("--threads must be between 1 and 1024");
+      if (t < 0 || t > 1024)
+        throw Usage_error("--threads must be between 1 and 1024 (0: all cores)");
       o.threads = int(t);
     } else if (a == "--seed") {
       o.seed = parse_number<unsigned long>(a, value());
@@ -514,6 +520,15 @@ int main_impl(int argc, char** argv)
 {
   const auto t0 = std::chrono::steady_clock::now();
   const Options o = parse_options(argc, argv);
+#ifdef CGAL_LINKED_WITH_TBB
+  // --threads N: at most N threads in every parallel stage of the process,
+  // normal estimation included (the library's own stages also run in an
+  // arena of N threads, see number_of_threads)
+  std::unique_ptr<tbb::global_control> thread_limit;
+  if (o.threads > 0)
+    thread_limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                         std::size_t(o.threads));
+#endif
   if (o.stream)
     return run_stream(o, t0);
   auto since = [](std::chrono::steady_clock::time_point t) {

@@ -32,7 +32,10 @@ inline std::vector<Sample> sphere(std::size_t n, std::mt19937_64& rng, Point c =
   std::normal_distribution<double> g;
   std::vector<Sample> s;
   for (std::size_t i = 0; i < n; ++i) {
-    const Vector d = unit(Vector(g(rng), g(rng), g(rng)));
+    // (the order of the draws made explicit: that of g++, which evaluates
+    // arguments right to left, so that every compiler gives the same clouds)
+    const double z = g(rng), y = g(rng), x = g(rng);
+    const Vector d = unit(Vector(x, y, z));
     s.push_back({c + r * d, d});
   }
   return s;
@@ -91,8 +94,10 @@ inline std::vector<std::pair<Point, Vector>> unoriented(const std::vector<Sample
   std::vector<std::pair<Point, Vector>> out;
   for (const Sample& x : s) {
     Vector n = x.n;
-    if (angle_noise > 0.0)
-      n = unit(n + Vector(g(rng), g(rng), g(rng)));
+    if (angle_noise > 0.0) {
+      const double gz = g(rng), gy = g(rng), gx = g(rng); // (g++'s order, see sphere())
+      n = unit(n + Vector(gx, gy, gz));
+    }
     out.push_back({x.p, coin(rng) ? n : -n});
   }
   return out;

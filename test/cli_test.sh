@@ -6,6 +6,7 @@
 # usage: cli_test.sh PATH_TO_orient_normals
 set -u
 prog=$(realpath "$1")
+here=$(cd "$(dirname "$0")" && pwd)
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 mkdir -p "$dir/tmp"
@@ -49,6 +50,36 @@ expect_exit 0 "konig criterion" "$prog" --quiet --criterion konig "$dir/sphere.x
 expect_exit 0 "threads and seed" "$prog" --quiet --threads 1 --seed 5 "$dir/sphere.xyz" "$dir/t1.xyz"
 expect_exit 0 "two threads" "$prog" --quiet --threads 2 --seed 5 "$dir/sphere.xyz" "$dir/t2.xyz"
 check "same result with 1 and 2 threads" cmp -s "$dir/t1.xyz" "$dir/t2.xyz"
+
+# determinism on a cloud large enough for every parallel path (the readers
+# and writers, the Morton order, the kNN, the graph, the sweep's batches):
+# the 20,000-point sample with random signs gives the same bytes with 1 and 2
+# threads (and with 0: all cores) for every solver, in core and with --stream
+awk 'BEGIN { srand(11) } { s = (rand() < 0.5) ? -1 : 1; print $1, $2, $3, s*$4, s*$5, s*$6 }' \
+  "$here/../examples/data/sample.xyz" > "$dir/det.xyz"
+check "the determinism cloud has 20,000 points" test "$(wc -l < "$dir/det.xyz")" -eq 20000
+for solver in mst qpbo-i lsa-tr; do
+  for t in 1 2 0; do
+    expect_exit 0 "$solver with --threads $t" "$prog" --quiet --solver $solver --threads $t "$dir/det.xyz" \
+      "$dir/det_${solver}_$t.xyz"
+  done
+  check "$solver: same bytes with 1 and 2 threads" cmp -s "$dir/det_${solver}_1.xyz" "$dir/det_${solver}_2.xyz"
+  check "$solver: same bytes with 1 thread and all cores" cmp -s "$dir/det_${solver}_1.xyz" "$dir/det_${solver}_0.xyz"
+done
+expect_exit 0 "qpbo-i to binary ply, 1 thread" "$prog" --quiet --threads 1 "$dir/det.xyz" "$dir/det_ply_1.ply"
+expect_exit 0 "qpbo-i to binary ply, 2 threads" "$prog" --quiet --threads 2 "$dir/det.xyz" "$dir/det_ply_2.ply"
+check "binary ply: same bytes with 1 and 2 threads" cmp -s "$dir/det_ply_1.ply" "$dir/det_ply_2.ply"
+for solver in mst qpbo-i lsa-tr; do
+  for t in 1 2; do
+    expect_exit 0 "stream, $solver with --threads $t" "$prog" --quiet --stream --solver $solver --threads $t \
+      "$dir/det.xyz" "$dir/det_stream_${solver}_$t.ply"
+  done
+  check "stream, $solver: same bytes with 1 and 2 threads" \
+    cmp -s "$dir/det_stream_${solver}_1.ply" "$dir/det_stream_${solver}_2.ply"
+done
+expect_exit 0 "stream to xyz, 1 thread" "$prog" --quiet --stream --threads 1 "$dir/det.xyz" "$dir/det_stream_1.xyz"
+expect_exit 0 "stream to xyz, 2 threads" "$prog" --quiet --stream --threads 2 "$dir/det.xyz" "$dir/det_stream_2.xyz"
+check "stream to xyz: same bytes with 1 and 2 threads" cmp -s "$dir/det_stream_1.xyz" "$dir/det_stream_2.xyz"
 
 expect_exit 0 "qpbo-i solver" "$prog" --quiet --json --solver qpbo-i --orders 2 "$dir/sphere.xyz" "$dir/qpbo.xyz"
 check "json names the qpbo-i solver" grep -q '"solver": "qpbo-i"' "$dir/out.txt"
@@ -158,6 +189,72 @@ if [ ! -e "$dir/big_out.ply" ]; then
   check "no temporary files after SIGTERM" test -z "$(ls -A "$dir/tmp")"
 fi
 
+# SIGINT likewise
+"$prog" --quiet --stream "$dir/big.xyz" "$dir/big_int.ply" 2> /dev/null &
+pid=$!
+sleep 0.5
+kill -INT $pid 2> /dev/null
+wait $pid
+status=$?
+check "SIGINT ends the run (status $status)" test "$status" -ne 0 -o -e "$dir/big_int.ply"
+check "no partial output after SIGINT" test -z "$(ls "$dir" | grep '^big_int.ply.tmp')"
+if [ ! -e "$dir/big_int.ply" ]; then
+  check "no temporary files after SIGINT" test -z "$(ls -A "$dir/tmp")"
+fi
+
+# SIGKILL cannot be caught, but the output is written to a temporary name and
+# renamed when complete: killed while it writes its output (a text output,
+# slow enough to be caught once its temporary file holds 1 MB), the run
+# leaves nothing at the output path (the temporary files stay: nothing can
+# remove them)
+"$prog" --quiet --stream "$dir/big.xyz" "$dir/big_kill.xyz" 2> /dev/null &
+pid=$!
+for _ in $(seq 1 6000); do
+  size=$(cat "$dir"/big_kill.xyz.tmp.* 2> /dev/null | wc -c)
+  [ "$size" -gt 1000000 ] && break
+  kill -0 $pid 2> /dev/null || break
+  sleep 0.01
+done
+kill -KILL $pid 2> /dev/null
+wait $pid 2> /dev/null # (no "Killed" notice)
+status=$?
+if [ -e "$dir/big_kill.xyz" ]; then # too late: the run had finished, the output must be whole
+  check "an output after SIGKILL is complete" test "$(wc -l < "$dir/big_kill.xyz")" -eq 400000
+else
+  check "SIGKILL while writing: killed (status $status)" test "$status" -eq 137
+  check "SIGKILL while writing: the temporary output was being written" test "$size" -gt 1000000
+fi
+rm -f "$dir"/big_kill.xyz* "$dir"/tmp/*
+
+# the disk fills up half way through a streamed run: files limited with
+# ulimit -f (SIGXFSZ ignored, so that writes beyond the limit fail with EFBIG
+# as they fail with ENOSPC on a full disk), first in the sweep (the record
+# file, 64 bytes a point, stops at 512 kB of 1.25 MB), then while writing the
+# output (a text output of 2 MB or more stops at 1.6 MB, after a record file
+# of 1.25 MB): exit 1, one line naming the file, no output, no temporary file
+limited() { # KB, then a command: runs it with files limited to KB kB
+  local kb="$1"; shift
+  ( trap '' XFSZ; ulimit -f "$kb"; exec "$@" )
+}
+expect_exit 1 "disk full during the sweep" limited 512 "$prog" --quiet --stream "$dir/det.xyz" "$dir/full.ply"
+check "disk full during the sweep: one-line error" test "$(wc -l < "$dir/err.txt")" -eq 1
+check "disk full during the sweep: the error says why" grep -q "cannot write .*normal_orientation_records_.*: File too large" "$dir/err.txt"
+check "disk full during the sweep: no output" test -z "$(find "$dir" -name 'full.ply*')"
+check "disk full during the sweep: no temporary file" test -z "$(ls -A "$dir/tmp")"
+awk 'BEGIN { srand(13) } { s = (rand() < 0.5) ? -1 : 1; printf "%.17g %.17g %.17g %.17g %.17g %.17g\n",
+  $1 + 1e-7 * rand(), $2 + 1e-7 * rand(), $3 + 1e-7 * rand(), s * ($4 + 1e-9 * rand()), s * ($5 + 1e-9 * rand()),
+  s * ($6 + 1e-9 * rand()) }' "$dir/det.xyz" > "$dir/long.xyz"
+expect_exit 0 "long text output" "$prog" --quiet --stream "$dir/long.xyz" "$dir/long_out.xyz"
+check "the long text output is larger than the limit" test "$(wc -c < "$dir/long_out.xyz")" -gt 2000000
+expect_exit 1 "disk full while writing the output" limited 1600 "$prog" --quiet --stream "$dir/long.xyz" "$dir/full.xyz"
+check "disk full while writing the output: one-line error" test "$(wc -l < "$dir/err.txt")" -eq 1
+check "disk full while writing the output: the error says why" grep -q "full.xyz.*File too large" "$dir/err.txt"
+check "disk full while writing the output: no output" test -z "$(find "$dir" -name 'full.xyz*')"
+check "disk full while writing the output: no temporary file" test -z "$(ls -A "$dir/tmp")"
+expect_exit 1 "a missing TMPDIR" env TMPDIR="$dir/no_such_dir" "$prog" --quiet --stream "$dir/det.xyz" "$dir/notmp.ply"
+check "a missing TMPDIR: one-line error" test "$(wc -l < "$dir/err.txt")" -eq 1
+check "a missing TMPDIR: no output" test -z "$(find "$dir" -name 'notmp.ply*')"
+
 # the progress line of --stream on a terminal (through script(1), when there):
 # stages and percentages on stderr, erased at the end, never in the JSON on
 # stdout; nothing with --quiet
@@ -178,7 +275,8 @@ check "estimated normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) b
 
 # bad options: exit 2, one line on stderr, no output (the options of --stream
 # need it)
-for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads 0" "--bogus" "--viewpoint 1,2" "--prior-weight 1" "--viewpoint 0,0,0 --prior-weight -1" "--viewpoint 0,0,0 --prior-weight nan" \
+for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads -1" "--threads x" \
+    "--threads 1025" "--threads" "--bogus" "--viewpoint 1,2" "--prior-weight 1" "--viewpoint 0,0,0 --prior-weight -1" "--viewpoint 0,0,0 --prior-weight nan" \
     "--presorted x" "--stream --presorted w" "--stream --presorted" "--components-dir $dir/cd" "--min-component-size 5" \
     "--stream --min-component-size -1" "--stream --min-component-size x"; do
   # shellcheck disable=SC2086

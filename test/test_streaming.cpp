@@ -1288,3 +1288,180 @@ TEST(Streaming_point_range, OrientsAUserRangeInPlaceAndChecksItsOrder)
   EXPECT_EQ(chunk[0].index, 0u);
   EXPECT_THROW(ns::make_point_range_source(points, np, 3), std::invalid_argument);
 }
+
+// ---------------------------------------------------------------------------
+// (g) fault injection: the disk becomes full half way through a run
+// ---------------------------------------------------------------------------
+//
+// RLIMIT_FSIZE, lowered from the progress callback at a chosen stage and
+// with SIGXFSZ ignored, stands for a disk that fills up: from then on every
+// write beyond that size fails (EFBIG, where a full disk gives ENOSPC), in
+// the temporary files (sort runs, record file) and the output alike.  (The
+// tests run as root, whom a read-only directory does not stop, and a small
+// tmpfs cannot be mounted in CI.)
+
+namespace {
+
+/// \brief Lowers RLIMIT_FSIZE on demand; restores it, and SIGXFSZ, when destroyed.
+class File_size_limit
+{
+public:
+  File_size_limit()
+  {
+    m_ok = ::getrlimit(RLIMIT_FSIZE, &m_saved) == 0;
+    m_old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  }
+  ~File_size_limit()
+  {
+    if (m_ok)
+      ::setrlimit(RLIMIT_FSIZE, &m_saved);
+    std::signal(SIGXFSZ, m_old_handler);
+  }
+  File_size_limit(const File_size_limit&) = delete;
+  File_size_limit& operator=(const File_size_limit&) = delete;
+  /// false when the limit cannot be lowered, or is too low already for the test's files
+  bool usable() const { return m_ok && (m_saved.rlim_cur == RLIM_INFINITY || m_saved.rlim_cur >= (rlim_t(1) << 30)); }
+  /// from now on, no file grows beyond `bytes`
+  void fill(rlim_t bytes)
+  {
+    rlimit limited = m_saved;
+    limited.rlim_cur = bytes;
+    ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limited), 0);
+    m_filled = true;
+  }
+  /// the former limit again
+  void restore()
+  {
+    ::setrlimit(RLIMIT_FSIZE, &m_saved);
+    m_filled = false;
+  }
+  bool filled() const { return m_filled; }
+
+private:
+  rlimit m_saved{};
+  void (*m_old_handler)(int) = SIG_DFL;
+  bool m_ok = false, m_filled = false;
+};
+
+/// every file and directory under `root`, recursively, as paths relative to it
+std::vector<std::string> tree(const std::string& root)
+{
+  std::vector<std::string> names;
+  for (const auto& entry : fs::recursive_directory_iterator(root))
+    names.push_back(fs::relative(entry.path(), root).string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+} // namespace
+
+// The disk fills up during the sort, the sweep (record file), the output or
+// the component files of streaming_orient_files: the run throws one clear
+// line naming the file and the reason, and leaves no output, no component
+// file and no temporary file; with the space back, the same run succeeds.
+TEST(Streaming_faults, DiskFullHalfWayLeavesNothing)
+{
+  File_size_limit limit;
+  if (!limit.usable())
+    GTEST_SKIP() << "RLIMIT_FSIZE cannot be lowered here";
+  Temporary_directory temporary, files;
+  std::mt19937_64 rng(31);
+  Test_cloud cloud;
+  cloud.ellipsoid(30000, Vec{{0., 0., 0.}}, 3., 1., 0.8, rng);
+  cloud.ellipsoid(10000, Vec{{8., 0., 0.}}, 1., 1., 1., rng);
+  std::shuffle(cloud.records.begin(), cloud.records.end(), rng);
+  const std::uint64_t n = cloud.records.size();
+  write_cloud(files.file("in.ply"), cloud.records);
+  const std::vector<std::string> before = tree(files.path());
+
+  NO::Streaming_options options = streaming_options_in(temporary.path());
+  options.batch_size = 2000;                                       // progress per batch of the sweep
+  options.sort.memory_budget = 4000 * sizeof(ns::internal::Keyed_record); // 10 runs of 224 kB
+  options.component_files.directory = files.file("parts");
+  const struct
+  {
+    NO::Streaming_stage stage;
+    std::uint64_t at;   // the disk fills once the stage has done this much
+    rlim_t bytes;       // files are limited to this size from then on
+  } faults[] = {
+    {NO::Streaming_stage::SORT, n / 2, 100000},      // the next run cannot be written
+    {NO::Streaming_stage::SWEEP, n / 2, 100000},     // the record file (64 bytes a point) stops growing
+    {NO::Streaming_stage::OUTPUT, 0, 200000},        // the output (48 bytes a point) stops at 200 kB
+    {NO::Streaming_stage::COMPONENTS, 0, 200000},    // so does the first component file
+  };
+  for (const auto& fault : faults) {
+    SCOPED_TRACE(NO::streaming_stage_name(fault.stage));
+    bool reached = false;
+    std::size_t most_temporary_files = 0;
+    options.callback = [&](const NO::Streaming_progress& p) {
+      most_temporary_files = std::max(most_temporary_files, temporary.count());
+      if (p.stage == fault.stage && p.done >= fault.at && !limit.filled()) {
+        reached = true;
+        limit.fill(fault.bytes);
+      }
+      return true;
+    };
+    std::string message;
+    try {
+      NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), options);
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
+    limit.restore();
+    EXPECT_TRUE(reached);
+    EXPECT_GE(most_temporary_files, 1u);
+    ASSERT_FALSE(message.empty()) << "the run did not fail";
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_NE(message.find("File too large"), std::string::npos) << message;
+    EXPECT_NE(message.find("cannot write"), std::string::npos) << message;
+    EXPECT_EQ(temporary.count(), 0u) << "temporary files left behind";
+    EXPECT_EQ(tree(files.path()), before) << "an output, a component file or a temporary output left behind";
+  }
+
+  // the same run with room enough
+  options.callback = nullptr;
+  const NO::Streaming_result r = NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), options);
+  EXPECT_EQ(r.number_of_points, n);
+  EXPECT_EQ(r.number_of_components, 2u);
+  EXPECT_EQ(read_cloud(files.file("out.ply")).size(), n);
+  EXPECT_EQ(temporary.count(), 0u);
+}
+
+// The same at the level of streaming_orient_normals, with a presorted
+// source (read by the sweep's own thread) and a sink of the caller's: a write
+// failure of the record file in the sweep is a std::system_error naming the
+// file, the sink has not been called, nothing is left in the temporary
+// directory.
+TEST(Streaming_faults, RecordFileWriteFailureInTheSweep)
+{
+  File_size_limit limit;
+  if (!limit.usable())
+    GTEST_SKIP() << "RLIMIT_FSIZE cannot be lowered here";
+  Temporary_directory temporary;
+  std::mt19937_64 rng(37);
+  Test_cloud cloud;
+  cloud.ellipsoid(40000, Vec{{0., 0., 0.}}, 4., 1., 1., rng);
+  const std::uint64_t n = cloud.records.size();
+  Vector_source source(sorted_by(cloud.records, 0));
+  NO::Streaming_options options = streaming_options_in(temporary.path());
+  options.presorted_axis = NO::Presorted_axis::X;
+  options.batch_size = 1000;
+  options.callback = [&](const NO::Streaming_progress& p) {
+    if (p.stage == NO::Streaming_stage::SWEEP && p.done >= n / 2 && !limit.filled())
+      limit.fill(64 * 1024);
+    return true;
+  };
+  std::vector<Point_record> out;
+  bool thrown = false;
+  try {
+    stream(source, options, out);
+  } catch (const std::system_error& e) {
+    thrown = true;
+    EXPECT_EQ(e.code(), std::errc::file_too_large) << e.what();
+    EXPECT_NE(std::string(e.what()).find("normal_orientation_records_"), std::string::npos) << e.what();
+  }
+  limit.restore();
+  EXPECT_TRUE(thrown);
+  EXPECT_TRUE(out.empty());
+  EXPECT_EQ(temporary.count(), 0u);
+}
