@@ -8,14 +8,10 @@
 // its normal is wrong if their dot product is <= 0 (zero normals included). It also counts
 // the points farther than F x (bounding-box diagonal of the mesh) from the mesh (default
 // F = 0.001), which should be none for a cloud sampled on the mesh by make_large_cloud.
+#include "Reference_mesh.h"
+
 #include <Normal_orientation/IO/Point_stream.h>
 #include <Normal_orientation/streaming/Point_record.h>
-
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
-#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
-#include <CGAL/IO/polygon_soup_io.h>
 
 #ifdef CGAL_LINKED_WITH_TBB
 #include <tbb/blocked_range.h>
@@ -42,20 +38,11 @@ namespace {
 
 namespace NO = Normal_orientation;
 
-/// Kernel of the mesh and of the queries.
-using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-/// Point type.
-using Point_3 = Kernel::Point_3;
-/// Vector type.
-using Vector_3 = Kernel::Vector_3;
-/// Triangle type.
-using Triangle_3 = Kernel::Triangle_3;
-/// Iterator over the mesh triangles: the primitive id of the AABB tree.
-using Triangle_iterator = std::vector<Triangle_3>::const_iterator;
-/// Primitive of the AABB tree.
-using Primitive = CGAL::AABB_triangle_primitive<Kernel, Triangle_iterator>;
-/// AABB tree over the mesh triangles.
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+using Normal_orientation::benchmark::Point_3;
+using Normal_orientation::benchmark::Reference_normals;
+using Normal_orientation::benchmark::Vector_3;
+/// Scratch space of the closest-triangle queries.
+using Candidates = std::vector<Normal_orientation::benchmark::Mesh_triangle_iterator>;
 
 /// Points read and processed at a time (56 MB of records).
 constexpr std::size_t chunk_size = std::size_t(1) << 20;
@@ -65,56 +52,6 @@ struct Usage_error : std::runtime_error
 {
   using std::runtime_error::runtime_error;
 };
-
-/// The mesh: non-degenerate triangles (fan-triangulated faces) and their outward unit normals.
-struct Reference_mesh
-{
-  /// Triangles with positive area, vertices in the order of the file.
-  std::vector<Triangle_3> triangles;
-  /// Unit normal of each triangle (right-hand rule: outward for an outward-oriented mesh).
-  std::vector<Vector_3> normals;
-  /// Bounding-box diagonal of the mesh vertices.
-  double bbox_diagonal = 0.0;
-};
-
-/**
- * \brief Reads `path` as a polygon soup, fan-triangulates its faces and drops the triangles
- * of zero area.
- * \throws std::runtime_error if the file cannot be read or has no usable triangle.
- */
-Reference_mesh read_mesh(const std::string& path)
-{
-  std::vector<Point_3> points;
-  std::vector<std::vector<std::size_t>> polygons;
-  std::error_code ec;
-  if(!std::filesystem::is_regular_file(path, ec))
-    throw std::runtime_error("cannot read mesh '" + path + "': no such file");
-  if(!CGAL::IO::read_polygon_soup(path, points, polygons) || points.empty())
-    throw std::runtime_error("cannot read mesh '" + path + "'");
-  Reference_mesh mesh;
-  const CGAL::Bbox_3 box = CGAL::bbox_3(points.begin(), points.end());
-  mesh.bbox_diagonal = std::sqrt(CGAL::square(box.xmax() - box.xmin()) + CGAL::square(box.ymax() - box.ymin()) +
-                                 CGAL::square(box.zmax() - box.zmin()));
-  for(const std::vector<std::size_t>& polygon : polygons)
-  {
-    for(std::size_t i : polygon)
-      if(i >= points.size())
-        throw std::runtime_error("mesh '" + path + "': vertex index out of range");
-    for(std::size_t j = 1; j + 1 < polygon.size(); ++j)
-    {
-      const Triangle_3 t(points[polygon[0]], points[polygon[j]], points[polygon[j + 1]]);
-      const Vector_3 c = CGAL::cross_product(t[1] - t[0], t[2] - t[0]);
-      const double twice_area = std::sqrt(c.squared_length());
-      if(!(twice_area > 0.0) || !std::isfinite(twice_area))
-        continue;
-      mesh.triangles.push_back(t);
-      mesh.normals.push_back(c / twice_area);
-    }
-  }
-  if(mesh.triangles.empty())
-    throw std::runtime_error("mesh '" + path + "' has no triangle of positive area");
-  return mesh;
-}
 
 /// Counts over a range of points (summed over the chunks and threads).
 struct Counts
@@ -135,57 +72,20 @@ struct Counts
   }
 };
 
-/**
- * \brief Returns a closest triangle of the mesh to `p` and its squared distance to `p`.
- *
- * Fast path for points on the surface: the triangles meeting the box of half-size `h` around
- * `p` (`all_intersected_primitives`, exact box-triangle test) are the candidates; if the
- * closest of them is within `h`, it is the closest triangle of the mesh (any closer triangle
- * would meet the ball of radius `h`, hence the box). Otherwise, and when no triangle meets the
- * box, `closest_point_and_primitive` answers. Both give a closest triangle; between
- * equidistant triangles (a point on an edge) the choice may differ.
- */
-std::pair<Triangle_iterator, double> closest_triangle(const Tree& tree, const Point_3& p, double h,
-                                              std::vector<Triangle_iterator>& candidates)
-{
-  candidates.clear();
-  const CGAL::Bbox_3 box(p.x() - h, p.y() - h, p.z() - h, p.x() + h, p.y() + h, p.z() + h);
-  tree.all_intersected_primitives(box, std::back_inserter(candidates));
-  double best = std::numeric_limits<double>::infinity();
-  Triangle_iterator best_triangle{};
-  for(const Triangle_iterator& t : candidates)
-  {
-    const double d2 = CGAL::squared_distance(p, *t);
-    if(d2 < best)
-    {
-      best = d2;
-      best_triangle = t;
-    }
-  }
-  if(!candidates.empty() && best <= h * h)
-    return {best_triangle, best};
-  const Tree::Point_and_primitive_id hit = tree.closest_point_and_primitive(p);
-  return {hit.second, CGAL::squared_distance(p, hit.first)};
-}
-
-/// Evaluates `records[begin, end)` against the mesh; `h` is the half-size of the fast-path box
-/// of closest_triangle().
-Counts evaluate(const Tree& tree, const Reference_mesh& mesh, const std::vector<NO::streaming::Point_record>& records,
-                std::size_t begin, std::size_t end, double h, double far_squared)
+/// Evaluates `records[begin, end)` against the mesh.
+Counts evaluate(const Reference_normals& reference, const std::vector<NO::streaming::Point_record>& records,
+                std::size_t begin, std::size_t end, double far_squared)
 {
   Counts counts;
-  const Triangle_iterator first = mesh.triangles.begin();
-  std::vector<Triangle_iterator> candidates;
+  Candidates candidates;
   for(std::size_t i = begin; i < end; ++i)
   {
     const NO::streaming::Point_record& r = records[i];
     const Point_3 p(r.position[0], r.position[1], r.position[2]);
-    const std::pair<Triangle_iterator, double> hit = closest_triangle(tree, p, h, candidates);
-    const Vector_3& truth = mesh.normals[static_cast<std::size_t>(hit.first - first)];
-    const double dot = truth.x() * r.normal[0] + truth.y() * r.normal[1] + truth.z() * r.normal[2];
-    if(!(dot > 0.0))
+    const std::pair<Vector_3, double> truth = reference.truth(p, candidates);
+    if(Reference_normals::is_wrong(truth.first, r.normal))
       ++counts.wrong;
-    const double d2 = hit.second;
+    const double d2 = truth.second;
     if(d2 > far_squared)
       ++counts.far;
     counts.max_squared_distance = (std::max)(counts.max_squared_distance, d2);
@@ -268,16 +168,12 @@ int run(const Options& o)
   NO::IO::Point_stream_reader reader(o.cloud);
   if(!reader.has_normals())
     throw std::runtime_error("cloud '" + o.cloud + "' has no normals");
-  const Reference_mesh mesh = read_mesh(o.mesh);
-  Tree tree(mesh.triangles.begin(), mesh.triangles.end());
-  tree.build();
-  tree.accelerate_distance_queries();
-  (void)tree.closest_point_and_primitive(mesh.triangles.front()[0]); // builds the search tree now
+  const Reference_normals reference(o.mesh); // builds the tree
+  const NO::benchmark::Reference_mesh& mesh = reference.mesh();
   const double tree_seconds = since(start);
 
   const double far_distance = o.far * mesh.bbox_diagonal;
   const double far_squared = far_distance * far_distance;
-  const double h = 1e-6 * mesh.bbox_diagonal; // fast path of closest_triangle()
   const auto query_start = Clock::now();
   double read_seconds = 0.0;
   Counts total;
@@ -297,7 +193,7 @@ int run(const Options& o)
     const Counts counts = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, chunk.size(), 4096), Counts(),
       [&](const tbb::blocked_range<std::size_t>& range, Counts partial) {
-        partial.join(evaluate(tree, mesh, chunk, range.begin(), range.end(), h, far_squared));
+        partial.join(evaluate(reference, chunk, range.begin(), range.end(), far_squared));
         return partial;
       },
       [](Counts a, const Counts& b) {
@@ -305,7 +201,7 @@ int run(const Options& o)
         return a;
       });
 #else
-    const Counts counts = evaluate(tree, mesh, chunk, 0, chunk.size(), h, far_squared);
+    const Counts counts = evaluate(reference, chunk, 0, chunk.size(), far_squared);
 #endif
     total.join(counts);
   }

@@ -108,6 +108,8 @@ struct Options
   std::string components_dir; // --stream: one file per component there
   unsigned long long min_component_size = 0;
   bool min_component_size_given = false;
+  bool write_segments = false; // --stream: the segment of each point in OUT (PLY)
+  unsigned long long batch_size = 0; // --stream: 0 = the library's default
 };
 
 const char* usage_text =
@@ -153,6 +155,12 @@ const char* usage_text =
   "  --min-component-size N  with --stream: drop the components of fewer than N\n"
   "                       points from OUT and the component files (counted in the\n"
   "                       report: dropped_points, dropped_components; default 0)\n"
+  "  --write-segments     with --stream and a .ply OUT: add to each point its segment\n"
+  "                       (vertex property 'int segment', 0 to segments - 1)\n"
+  "  --batch-size N       with --stream: points whose neighbours are searched at\n"
+  "                       once (one kd-tree each; default 262144): larger is\n"
+  "                       faster and holds more points (the peak window grows by\n"
+  "                       about 2N); the output does not depend on N\n"
   "  --ascii              write PLY as ascii instead of binary\n"
   "  --json               print one JSON object with the report on stdout\n"
   "  --quiet              print nothing on stderr but errors\n"
@@ -261,6 +269,13 @@ Options parse_options(int argc, char** argv)
         throw Usage_error("--min-component-size must be a number of points >= 0");
       o.min_component_size = (unsigned long long)m;
       o.min_component_size_given = true;
+    } else if (a == "--write-segments") {
+      o.write_segments = true;
+    } else if (a == "--batch-size") {
+      const long long b = parse_number<long long>(a, value());
+      if (b < 1 || b > (1ll << 30))
+        throw Usage_error("--batch-size must be a number of points between 1 and 2^30");
+      o.batch_size = (unsigned long long)b;
     } else if (a.size() > 1 && a[0] == '-') {
       throw Usage_error("unknown option " + a);
     } else {
@@ -277,8 +292,12 @@ Options parse_options(int argc, char** argv)
     throw Usage_error("--presorted needs --stream");
   if (!o.stream && !o.components_dir.empty())
     throw Usage_error("--components-dir needs --stream");
+  if (!o.stream && o.batch_size != 0)
+    throw Usage_error("--batch-size needs --stream");
   if (!o.stream && o.min_component_size_given)
     throw Usage_error("--min-component-size needs --stream");
+  if (!o.stream && o.write_segments)
+    throw Usage_error("--write-segments needs --stream");
   if (positional.empty()) {
     o.input = NORMAL_ORIENTATION_SAMPLE_CLOUD;
     o.output = "sample_oriented.ply";
@@ -294,6 +313,8 @@ Options parse_options(int argc, char** argv)
                          : o.input + "_oriented.ply";
     }
   }
+  if (o.write_segments && NO::IO::internal::lower_case_extension(o.output) != ".ply")
+    throw Usage_error("--write-segments needs a .ply OUT");
   return o;
 }
 
@@ -450,11 +471,14 @@ int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
                       : o.presorted == "z" ? NO::Presorted_axis::Z
                                            : NO::Presorted_axis::NONE;
   so.minimum_component_size = o.min_component_size;
+  if (o.batch_size != 0)
+    so.batch_size = std::size_t(o.batch_size);
   so.component_files.directory = o.components_dir; // in OUT's format
   Stage_progress_line progress(!o.quiet);
   so.callback = [&progress](const NO::Streaming_progress& p) { return progress(p); };
   NO::IO::Point_stream_write_options wo;
   wo.binary = !o.ascii;
+  wo.segments = o.write_segments;
   NO::Streaming_result r;
   auto with_solver = [&](const auto& criterion) {
     if (o.solver == "mst")

@@ -171,8 +171,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     if(core_error.empty()) {
       if(!streamed.error.empty()) {
-        FUZZ_CHECK(binary && streamed.error.find(" bytes of unexpected data at byte offset ") != std::string::npos,
-                   what + ": error '" + streamed.error + "' where read_point_cloud() reads the file");
+        FUZZ_CHECK(false, what + ": error '" + streamed.error + "' where read_point_cloud() reads the file");
         return;
       }
       FUZZ_CHECK(streamed.records.size() == cloud.size(), what + ": " + std::to_string(streamed.records.size()) +

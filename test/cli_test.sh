@@ -80,6 +80,10 @@ done
 expect_exit 0 "stream to xyz, 1 thread" "$prog" --quiet --stream --threads 1 "$dir/det.xyz" "$dir/det_stream_1.xyz"
 expect_exit 0 "stream to xyz, 2 threads" "$prog" --quiet --stream --threads 2 "$dir/det.xyz" "$dir/det_stream_2.xyz"
 check "stream to xyz: same bytes with 1 and 2 threads" cmp -s "$dir/det_stream_1.xyz" "$dir/det_stream_2.xyz"
+# the batch size of the sweep changes how the work is cut, not the result
+expect_exit 0 "stream with batches of 1000" "$prog" --quiet --stream --batch-size 1000 "$dir/det.xyz" \
+  "$dir/det_stream_b1000.xyz"
+check "stream: same bytes with batches of 1000 and the default" cmp -s "$dir/det_stream_1.xyz" "$dir/det_stream_b1000.xyz"
 
 expect_exit 0 "qpbo-i solver" "$prog" --quiet --json --solver qpbo-i --orders 2 "$dir/sphere.xyz" "$dir/qpbo.xyz"
 check "json names the qpbo-i solver" grep -q '"solver": "qpbo-i"' "$dir/out.txt"
@@ -124,6 +128,24 @@ expect_exit 0 "stream, not quiet" "$prog" --json --stream "$dir/sphere.xyz" "$di
 check "no progress line on a stderr that is not a terminal" test "$(tr -cd '\r' < "$dir/err.txt" | wc -c)" -eq 0
 check "stream summary on stderr" grep -q "oriented 600 points out of core" "$dir/err.txt"
 check "stream json is one line" test "$(wc -l < "$dir/out.txt")" -eq 1
+
+# --write-segments: the segment of each point as the PLY vertex property
+# 'int segment', as many distinct values (0 to segments - 1) as the JSON says
+expect_exit 0 "stream --write-segments (ascii ply)" "$prog" --quiet --json --stream --write-segments --ascii \
+  "$dir/det.xyz" "$dir/seg.ply"
+segments=$(sed -n 's/.*"segments": \([0-9]*\),.*/\1/p' "$dir/out.txt")
+check "the segment property is declared" grep -q "^property int segment$" "$dir/seg.ply"
+check "one segment per point, $segments distinct values, 0 to segments - 1" awk -v n="$segments" '
+  header { if ($0 == "end_header") header = 0; else if ($1 == "property") column++; next }
+  { if (NF != column || $column < 0 || $column >= n || $column != int($column)) bad++; if (!($column in seen)) distinct++;
+    seen[$column] = 1; points++ }
+  END { exit (bad > 0 || distinct != n || points != 20000 || n < 2) }' header=1 column=0 "$dir/seg.ply"
+expect_exit 0 "stream --write-segments (binary ply)" "$prog" --quiet --stream --write-segments "$dir/det.xyz" \
+  "$dir/seg_bin.ply"
+check "binary: the segment property is declared" grep -aq "^property int segment$" "$dir/seg_bin.ply"
+check "binary: 52 bytes per point" test "$(wc -c < "$dir/seg_bin.ply")" -eq \
+  "$(( $(grep -abo "end_header" "$dir/seg_bin.ply" | head -1 | cut -d: -f1) + 11 + 20000 * 52 ))"
+expect_exit 0 "a cloud with segments reads back" "$prog" --quiet --solver mst "$dir/seg_bin.ply" "$dir/seg_back.ply"
 
 # --presorted: a file sorted by x gives the same oriented points as the sorted
 # path, in its own order; an unsorted one fails at once
@@ -278,7 +300,8 @@ check "estimated normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) b
 for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads -1" "--threads x" \
     "--threads 1025" "--threads" "--bogus" "--viewpoint 1,2" "--prior-weight 1" "--viewpoint 0,0,0 --prior-weight -1" "--viewpoint 0,0,0 --prior-weight nan" \
     "--presorted x" "--stream --presorted w" "--stream --presorted" "--components-dir $dir/cd" "--min-component-size 5" \
-    "--stream --min-component-size -1" "--stream --min-component-size x"; do
+    "--stream --min-component-size -1" "--stream --min-component-size x" "--write-segments" \
+    "--stream --write-segments" "--batch-size 10" "--stream --batch-size 0" "--stream --batch-size x"; do
   # shellcheck disable=SC2086
   expect_exit 2 "bad option $args" "$prog" $args "$dir/sphere.xyz" "$dir/bad_opt.xyz"
   check "one-line error for $args" test "$(wc -l < "$dir/err.txt")" -eq 1

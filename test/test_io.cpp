@@ -1563,19 +1563,21 @@ TEST(Point_stream, reading_errors_name_the_file_and_the_place)
   fs::create_directory(directory.file("dir.xyz"));
   EXPECT_EQ(stream_error(directory.file("dir.xyz")), error_message([&] { read_point_cloud(directory.file("dir.xyz")); }));
 
-  // Bytes after the binary data: an error of the streaming reader only (with the byte
-  // offset), found by the constructor or, after a list element, at the end of the data.
+  // Bytes after the binary data: an error of both readers (with the byte offset), found
+  // by the streaming reader's constructor or, after a list element, at the end of the data.
   Bytes three{two_vertices, false};
   three << 7.f << 8.f << 9.f << 0.f << 0.f << 1.f;
   write_file(directory.file("garbage.ply"), three.data + "abc");
-  EXPECT_EQ(read_point_cloud(directory.file("garbage.ply")).size(), 3u);
+  EXPECT_EQ(error_message([&] { read_point_cloud(directory.file("garbage.ply")); }),
+            stream_error(directory.file("garbage.ply")));
   EXPECT_EQ(stream_error(directory.file("garbage.ply")),
             directory.file("garbage.ply") + ": 3 bytes of unexpected data at byte offset " +
               std::to_string(three.data.size()) + ", after the last vertex of the PLY data");
   Bytes face_garbage{face_last.data, false};
   face_garbage << std::uint8_t(0) << std::uint8_t(7);
   write_file(directory.file("face_garbage.ply"), face_garbage.data);
-  EXPECT_EQ(read_point_cloud(directory.file("face_garbage.ply")).size(), 2u);
+  EXPECT_EQ(error_message([&] { read_point_cloud(directory.file("face_garbage.ply")); }),
+            stream_error(directory.file("face_garbage.ply")));
   EXPECT_EQ(stream_error(directory.file("face_garbage.ply")),
             directory.file("face_garbage.ply") + ": 1 bytes of unexpected data at byte offset " +
               std::to_string(face_garbage.data.size() - 1) + ", after the last row of element 'face' of the PLY data");

@@ -282,6 +282,54 @@ TEST(Orient_normals, DegenerateCloudsAreHandled)
   EXPECT_EQ(rs.energy_after, 0.0);
 }
 
+TEST(Orient_normals, OutliersTinyComponentsAndUnnormalisedNormals)
+{
+  // two points: one edge at most, finite energies, only signs change
+  std::vector<PN> two{{Point(0, 0, 0), Vector(0, 0, 1)}, {Point(0.1, 0, 0), Vector(0, 0, -2)}};
+  const auto r2 = NO::orient_normals(two, pn_params());
+  EXPECT_LE(r2.number_of_edges, 1u);
+  EXPECT_TRUE(std::isfinite(r2.energy_after));
+  EXPECT_EQ(std::abs(two[1].second.z()), 2.0);
+
+  // a sphere, far outliers (lone points), 100 components of 3 points, and
+  // normals of lengths from 1e-3 to 1e3
+  std::mt19937_64 rng(21);
+  const auto truth = sphere(5000, rng);
+  auto cloud = unoriented(truth, rng);
+  std::uniform_real_distribution<double> length(-3.0, 3.0), far(-1e6, 1e6);
+  for (PN& x : cloud)
+    x.second = x.second * std::pow(10.0, length(rng));
+  for (int o = 0; o < 20; ++o)
+    cloud.push_back({Point(far(rng), far(rng), 1e6 + far(rng)), Vector(0, 1, 0) * (o % 2 ? 1.0 : -3.0)});
+  // (few enough, 6% of the points, to leave the estimated radius to the sphere)
+  for (int c = 0; c < 100; ++c) { // triangles 10 apart along x, far from the sphere
+    const double x0 = 1000.0 + 10.0 * c;
+    cloud.push_back({Point(x0, 0, 0), Vector(0, 0, 1)});
+    cloud.push_back({Point(x0 + 0.01, 0, 0), Vector(0, 0, -1)});
+    cloud.push_back({Point(x0, 0.01, 0), Vector(0, 0, 0.5)});
+  }
+  const auto input = cloud;
+  const auto r = NO::orient_normals(cloud, pn_params());
+  ASSERT_EQ(cloud.size(), input.size());
+  EXPECT_GE(r.number_of_components, 100u + 1u);
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    EXPECT_EQ(cloud[i].first, input[i].first);
+    const Vector& n = cloud[i].second;
+    ASSERT_TRUE(std::isfinite(n.x()) && std::isfinite(n.y()) && std::isfinite(n.z())) << "point " << i;
+    EXPECT_TRUE(n == input[i].second || n == -input[i].second) << "point " << i << ": more than the sign changed";
+    if (i < truth.size())
+      wrong += truth[i].n * n <= 0.0;
+  }
+  EXPECT_EQ(wrong, 0u) << "the outliers and the small components must not disturb the sphere";
+  // every 3-point component is consistent: its three normals on one side
+  for (int c = 0; c < 100; ++c) {
+    const std::size_t f = truth.size() + 20 + 3 * std::size_t(c);
+    EXPECT_GT(cloud[f].second.z() * cloud[f + 1].second.z(), 0.0) << "component " << c;
+    EXPECT_GT(cloud[f].second.z() * cloud[f + 2].second.z(), 0.0) << "component " << c;
+  }
+}
+
 TEST(Orient_normals, CallbackReportsProgressAndInterrupts)
 {
   std::mt19937_64 rng(11);

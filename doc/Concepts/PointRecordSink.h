@@ -14,6 +14,12 @@ normal back into the user's own container (`Normal_orientation::streaming::Norma
 or append the record to a file (`Normal_orientation::streaming_orient_files()` uses a
 `Normal_orientation::IO::Point_stream_writer`).
 
+A sink that can also be called with a second argument, `std::uint32_t segment`, is called
+so: it then gets the segment of the point too (the segments of the streaming segmentation,
+numbered from 0 to `Normal_orientation::Streaming_result::number_of_segments` - 1), which is
+how `Normal_orientation::streaming_orient_files()` writes them with
+`Normal_orientation::IO::Point_stream_write_options::segments`.
+
 \cgalHasModelsBegin
 \cgalHasModels{Normal_orientation::streaming::Normal_writer}
 \cgalHasModels{any function object such as a lambda, e.g. one calling Normal_orientation::IO::Point_stream_writer::write()}
@@ -26,4 +32,7 @@ class PointRecordSink
 public:
   /// receives one oriented point
   void operator()(const Normal_orientation::streaming::Point_record& record);
+  /// optional: receives one oriented point and its segment (called instead of the
+  /// operator above when the sink has it)
+  void operator()(const Normal_orientation::streaming::Point_record& record, std::uint32_t segment);
 };

@@ -204,20 +204,44 @@ struct Knn_tree_types
   /// Writes to `out` / `out_d2` the k nearest neighbours of point `self`
   /// of the tree (itself excluded; fewer when the tree has fewer points)
   /// and their squared distances in single precision; returns how many.
+  /// When `sorted`, by increasing distance; otherwise in the search's own
+  /// order (the same set, up to ties at the k-th distance when `self` is not
+  /// among the k + 1 nearest, i.e. with more than k coincident points),
+  /// which saves sorting each result.
   static unsigned int nearest(const Tree& tree, const Distance& distance, const Point& query, std::uint32_t self,
-                              unsigned int k, std::uint32_t* out, float* out_d2)
+                              unsigned int k, std::uint32_t* out, float* out_d2, bool sorted = true)
   {
-    Search search(tree, query, k + 1, 0, true, distance, true);
+    double exact[64]; // unsorted: the distances compared, in double precision
+    if (k > 64)
+      sorted = true;
+    Search search(tree, query, k + 1, 0, true, distance, sorted);
     unsigned int t = 0;
     bool self_skipped = false;
-    for (auto it = search.begin(); it != search.end() && t < k; ++it) {
+    for (auto it = search.begin(); it != search.end(); ++it) {
       if (!self_skipped && it->first == self) {
         self_skipped = true;
         continue;
       }
-      out[t] = it->first;
-      out_d2[t] = float(CGAL::to_double(it->second));
-      ++t;
+      const double d2 = CGAL::to_double(it->second);
+      if (t < k) {
+        out[t] = it->first;
+        out_d2[t] = float(d2);
+        if (!sorted)
+          exact[t] = d2;
+        ++t;
+      } else if (sorted) {
+        break;
+      } else { // k + 1 others: keep the k nearest (the first of equals stays)
+        unsigned int far = 0;
+        for (unsigned int s = 1; s < k; ++s)
+          if (exact[s] > exact[far])
+            far = s;
+        if (d2 < exact[far]) {
+          out[far] = it->first;
+          out_d2[far] = float(d2);
+          exact[far] = d2;
+        }
+      }
     }
     return t;
   }

@@ -44,6 +44,7 @@
 #include <stdexcept>
 #include <string>
 #include <system_error>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -134,7 +135,8 @@ struct Component_files_options
   /// `streaming_orient_normals()`, the output's format (extension and write
   /// options) in `streaming_orient_files()`
   std::string extension;
-  /// how the files are written (binary or ascii PLY, normals)
+  /// how the files are written (binary or ascii PLY, normals; `segments` is
+  /// ignored: the component files hold no segments)
   IO::Point_stream_write_options write_options;
   /// the most component files open at once (at least 1; each buffers
   /// 1 MiB).  With more components than that, one pass over the record
@@ -265,6 +267,17 @@ inline std::array<double, 3> unit_normal(const streaming::Point_record& r)
   return {r.normal[0] * inv, r.normal[1] * inv, r.normal[2] * inv};
 }
 
+/// Hands `record` to `sink`, with the segment of the point when the sink
+/// takes it (see `PointRecordSink`).
+template <typename Sink>
+void hand_to_sink(Sink& sink, const streaming::Point_record& record, std::uint32_t segment)
+{
+  if constexpr (std::is_invocable_v<Sink&, const streaming::Point_record&, std::uint32_t>)
+    sink(record, segment);
+  else
+    sink(record);
+}
+
 /// Calls the user's progress callback, if any; throws `Interrupted` when it
 /// returns false.
 class Streaming_reporter
@@ -384,7 +397,10 @@ private:
 /// Orients the points of `source` out of core and hands them to `sink`
 /// (`sink(const streaming::Point_record&)`, called once per point kept, in
 /// the sweep order, with the oriented normal: only its sign differs from the
-/// input's).
+/// input's; a sink callable as `sink(record, std::uint32_t segment)` is
+/// called so, with the segment of the point: the segments are numbered 0 to
+/// `Streaming_result::number_of_segments` - 1 in the order the sweep opened
+/// them, and each holds at least one point).
 ///
 /// `source` is a streaming source (`read(chunk, maximum)`, `rewind()`; see
 /// `external_sort.h`), read twice: a first pass, then the external sort, or,
@@ -842,7 +858,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
           continue;
         if (finish(s, out))
           ++result.number_of_flipped;
-        sink(out);
+        internal::hand_to_sink(sink, out, s.segment);
       }
       report(Streaming_stage::OUTPUT, read, n);
     }
@@ -859,11 +875,13 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     std::uint64_t done = 0;
     report(Streaming_stage::COMPONENTS, 0, total);
     std::vector<IO::Point_stream_writer> writers;
+    IO::Point_stream_write_options component_write_options = options.component_files.write_options;
+    component_write_options.segments = false;
     auto open_writers = [&](std::size_t first, std::size_t last) {
       writers.clear();
       writers.reserve(last - first);
       for (std::size_t r = first; r < last; ++r)
-        writers.emplace_back(component_files.path(r), options.component_files.write_options);
+        writers.emplace_back(component_files.path(r), component_write_options);
     };
     auto commit_writers = [&]() {
       for (IO::Point_stream_writer& w : writers) {
@@ -956,17 +974,23 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
 /// without the components smaller than
 /// `Streaming_options::minimum_component_size`.  It is written to a
 /// temporary file renamed at the end: on any error no output file exists.
+/// With `write_options.segments` (PLY only), each point of `output` also
+/// gets its segment, as the vertex property `int segment` (the segments of
+/// `streaming_orient_normals()`: as many distinct values as
+/// `Streaming_result::number_of_segments` when no component is dropped).
 /// With `Streaming_options::component_files` (a directory), one file per
 /// kept component is written there too, by default in the output's format
 /// (see `Component_files_options::extension`); they are removed when the
 /// run fails, the output's last step included.
-/// \throw IO::Io_error for unreadable, malformed or unwritable files, or an
-///        input without normals; see `streaming_orient_normals()`
+/// \throw IO::Io_error for unreadable, malformed or unwritable files, an
+///        input without normals or without any point (as `read_point_cloud()`
+///        does; no output is written then); see `streaming_orient_normals()`
 /// \tparam ConcurrencyTag, Kernel, FlipCriterion, Solver as for `streaming_orient_normals()`
 /// \param input the file to orient (.xyz/.pwn with normals, or .ply with normals)
 /// \param output the file written (.xyz, .pwn or .ply)
 /// \param options, criterion, solver as for `streaming_orient_normals()`
-/// \param write_options how `output` is written (binary or ascii PLY, ...)
+/// \param write_options how `output` is written (binary or ascii PLY, with the
+///        segments, ...)
 /// \return the figures of the run
 template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag,
           typename Kernel = CGAL::Exact_predicates_inexact_constructions_kernel,
@@ -987,10 +1011,17 @@ Streaming_result streaming_orient_files(const std::string& input, const std::str
     o.component_files.extension = std::filesystem::path(output).extension().string();
     o.component_files.write_options = write_options;
   }
-  auto sink = [&writer](const streaming::Point_record& r) { writer.write(r); };
+  auto sink = [&writer](const streaming::Point_record& r, std::uint32_t segment) {
+    if (writer.has_segments())
+      writer.write(r, segment);
+    else
+      writer.write(r);
+  };
   Streaming_result result =
     streaming_orient_normals<ConcurrencyTag, Kernel>(reader, sink, o, criterion, solver);
   const auto t = std::chrono::steady_clock::now();
+  if (result.number_of_points == 0) // as in core: an empty cloud is an error, not an empty output
+    throw IO::Io_error(input + ": the file holds no point");
   try {
     writer.commit();
   } catch (...) {

@@ -1668,6 +1668,13 @@ inline Point_cloud parse_ply_data(const std::string& filename, const char* begin
     else
       p = skip_binary_element(filename, element, begin, p, end, swap);
   }
+  if(p < end) { // most often a wrong element count: refused rather than guessed at
+    const Ply_header_element& last = header.elements.back();
+    fail(filename, std::to_string(end - p) + " bytes of unexpected data at byte offset " + std::to_string(p - begin) +
+                     ", after the last " +
+                     (last.name == "vertex" ? std::string("vertex") : "row of element '" + last.name + "'") +
+                     " of the PLY data");
+  }
   return cloud;
 }
 

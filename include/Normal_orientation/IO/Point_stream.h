@@ -7,8 +7,8 @@
 /// `Point_stream_reader` reads the same files as `read_point_cloud()` and gives, point
 /// by point and bit for bit, the same coordinates and normals, as
 /// `streaming::Point_record`s numbered 0, 1, ... in file order. It reports the same
-/// errors with the same messages, with one addition: bytes after the last element of a
-/// binary PLY file are an error. Errors are found as the data are read, so an error in
+/// errors with the same messages (bytes after the last element of a binary PLY file
+/// included, with their byte offset). Errors are found as the data are read, so an error in
 /// the middle of the file is reported by the `read()` call that reaches it (header
 /// errors, and in binary PLY files most size mismatches, by the constructor).
 ///
@@ -256,7 +256,7 @@ constexpr std::size_t max_streamed_ply_header_size = std::size_t(1) << 20;
 ///
 /// Errors are reported as `Io_error` with the messages of `read_point_cloud()` (file
 /// name, then line number for text data, vertex or row number for binary data), by the
-/// constructor for the header, by `read()` for the data. Additionally, a binary PLY file
+/// constructor for the header, by `read()` for the data. As there, a binary PLY file
 /// with bytes after its last element is rejected (with the byte offset). The elements
 /// following `vertex` are checked when the last vertex is read. After an error, `read()`
 /// throws the same error again until `rewind()`.
@@ -695,6 +695,11 @@ struct Point_stream_write_options
   bool binary = true;
   /// Write the normals (`nx ny nz`) of the records; only `x y z` otherwise.
   bool normals = true;
+  /// PLY only: add the vertex property `int segment`, after the others, whose values are
+  /// given to `Point_stream_writer::write(const streaming::Point_record&, std::uint32_t)`
+  /// (`streaming_orient_files()` writes there the segment of each point). A `.xyz`/`.pwn`
+  /// file cannot hold it: the writer's constructor throws `Io_error` then.
+  bool segments = false;
 };
 
 /// \brief Sequential writer of `streaming::Point_record`s to a point cloud file.
@@ -706,7 +711,9 @@ struct Point_stream_write_options
 /// per point) or `ascii` (shortest exact text). Normals are written as `double`, not
 /// `float`, so that every value read back by `read_point_cloud()` or
 /// `Point_stream_reader` is bit for bit the value written. The `index` of the records
-/// is not written: records are written in the order given.
+/// is not written: records are written in the order given. With
+/// `Point_stream_write_options::segments`, a PLY file has one more vertex property,
+/// `int segment`, and each record is written with its segment.
 ///
 /// The data go to a temporary file `<filename>.tmp.<pid>.<n>` in the directory of
 /// `filename`, renamed over `filename` by `commit()` (for PLY, after the vertex count,
@@ -718,7 +725,8 @@ class Point_stream_writer
 {
 public:
   /// \brief Creates the temporary file and, for PLY, writes the header.
-  /// \throws Io_error on an unknown extension or if the temporary file cannot be created.
+  /// \throws Io_error on an unknown extension, if the temporary file cannot be created,
+  /// or if `options.segments` is set for a `.xyz`/`.pwn` file.
   explicit Point_stream_writer(const std::string& filename,
                                const Point_stream_write_options& options = Point_stream_write_options())
     : filename_(filename), options_(options)
@@ -728,6 +736,7 @@ public:
     else if(extension != ".xyz" && extension != ".pwn")
       internal::fail(filename, "unknown point cloud file extension '" + extension +
                                  "' (expected .xyz, .pwn or .ply)");
+    if(!ply_ && options_.segments) internal::fail(filename, "segments can only be written to a .ply file");
     out_.reset(new internal::Atomic_output_file(filename));
     if(!ply_) return;
     std::string header = "ply\nformat ";
@@ -737,6 +746,7 @@ public:
     header += std::string(count_width, ' ') + "\n";
     header += "property double x\nproperty double y\nproperty double z\n";
     if(options_.normals) header += "property double nx\nproperty double ny\nproperty double nz\n";
+    if(options_.segments) header += "property int segment\n";
     header += "end_header\n";
     out_->put(header);
   }
@@ -754,34 +764,32 @@ public:
   const std::string& filename() const { return filename_; }
   /// \brief Returns `true` if the normals are written.
   bool has_normals() const { return options_.normals; }
+  /// \brief Returns `true` if a segment is written with each record
+  /// (`Point_stream_write_options::segments`).
+  bool has_segments() const { return options_.segments; }
   /// \brief Number of records written so far.
   std::uint64_t count() const { return count_; }
 
   /// \brief Writes `record` (its position and, if `has_normals()`, its normal).
   /// \throws Io_error if a value is not finite (nothing of the record is written then),
-  /// on a writing error, or after `commit()`.
+  /// on a writing error, after `commit()`, or if `has_segments()` (a segment is needed).
   void write(const streaming::Point_record& record)
   {
-    using namespace internal;
-    if(committed_) fail(filename_, "cannot write: the file was already committed");
-    check_finite_values(filename_, record.position, options_.normals ? record.normal : nullptr,
-                        "vertex", count_);
-    const std::size_t values = options_.normals ? 6 : 3;
-    if(ply_ && options_.binary) {
-      char* target = out_->room(values * sizeof(double));
-      const bool swap = !host_is_little_endian();
-      for(std::size_t c = 0; c < values; ++c)
-        store_scalar(target + c * sizeof(double), c < 3 ? record.position[c] : record.normal[c - 3],
-                     Ply_scalar_type::FLOAT64, swap);
-      out_->advance(values * sizeof(double));
-    } else {
-      for(std::size_t c = 0; c < values; ++c) {
-        if(c != 0) out_->put(' ');
-        out_->put_shortest(c < 3 ? record.position[c] : record.normal[c - 3]);
-      }
-      out_->put('\n');
-    }
-    ++count_;
+    if(options_.segments) internal::fail(filename_, "cannot write a point without its segment");
+    write_values(record, 0);
+  }
+
+  /// \brief Writes `record` as `write(const streaming::Point_record&)` does, followed by
+  /// `segment` (the `int segment` property).
+  /// \throws Io_error as `write(const streaming::Point_record&)`, if `has_segments()` is
+  /// `false`, or if `segment` exceeds the range of `int` (2^31 - 1); nothing of the
+  /// record is written then.
+  void write(const streaming::Point_record& record, std::uint32_t segment)
+  {
+    if(!options_.segments) internal::fail(filename_, "cannot write a segment: segments are not enabled");
+    if(segment > 2147483647u)
+      internal::fail(filename_, "segment " + std::to_string(segment) + " exceeds the range of a PLY int");
+    write_values(record, segment);
   }
 
   /// \brief Writes the records of `records`, in order.
@@ -812,6 +820,39 @@ private:
   /// Width of the vertex count in the PLY header: the digits of any 64-bit count,
   /// padded with blanks.
   static constexpr std::size_t count_width = 20;
+
+  /// Writes `record` and, if `has_segments()`, `segment` (at most 2^31 - 1).
+  void write_values(const streaming::Point_record& record, std::uint32_t segment)
+  {
+    using namespace internal;
+    if(committed_) fail(filename_, "cannot write: the file was already committed");
+    check_finite_values(filename_, record.position, options_.normals ? record.normal : nullptr,
+                        "vertex", count_);
+    const std::size_t values = options_.normals ? 6 : 3;
+    if(ply_ && options_.binary) {
+      char* target = out_->room(values * sizeof(double));
+      const bool swap = !host_is_little_endian();
+      for(std::size_t c = 0; c < values; ++c)
+        store_scalar(target + c * sizeof(double), c < 3 ? record.position[c] : record.normal[c - 3],
+                     Ply_scalar_type::FLOAT64, swap);
+      out_->advance(values * sizeof(double));
+      if(options_.segments) {
+        store_scalar(out_->room(4), static_cast<double>(segment), Ply_scalar_type::INT32, swap);
+        out_->advance(4);
+      }
+    } else {
+      for(std::size_t c = 0; c < values; ++c) {
+        if(c != 0) out_->put(' ');
+        out_->put_shortest(c < 3 ? record.position[c] : record.normal[c - 3]);
+      }
+      if(options_.segments) {
+        out_->put(' ');
+        out_->put_shortest(static_cast<long long>(segment));
+      }
+      out_->put('\n');
+    }
+    ++count_;
+  }
 
   std::string filename_;
   Point_stream_write_options options_;

@@ -311,6 +311,7 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
   std::vector<Reverse> reverse, bucketed;
   std::vector<std::size_t> batch_first;
   std::vector<Sweep_neighbor> batch_neighbors;
+  std::vector<std::vector<Sweep_neighbor>> block_lists; // per block of 1024 points of a batch
   std::vector<std::size_t> bucket_start, bucket_begin;
   std::vector<Point> points;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed; // (Morton code, slot), sorted
@@ -340,7 +341,8 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
       for (std::size_t q = b; q < e; ++q) {
         const std::uint32_t i = queries[q];
         const std::size_t row = std::size_t(keyed[i].second - first_slot) * k;
-        const unsigned int found = Types::nearest(tree, distance, points[i], i, k, nb.data(), &job.knn_d2[row]);
+        const unsigned int found =
+          Types::nearest(tree, distance, points[i], i, k, nb.data(), &job.knn_d2[row], false); // order: not needed
         for (unsigned int t = 0; t < found; ++t)
           job.knn[row + t] = keyed[nb[t]].second; // tree position -> slot
       }
@@ -475,25 +477,33 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
                              [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence == c.sequence; }),
                  list.end());
     };
+    // In blocks of fixed size (the result does not depend on the threads):
+    // each block's lists are written to a buffer of its own, then copied
+    // to their place once the counts are known.
+    const std::size_t block = 1024, blocks = (count + block - 1) / block;
+    block_lists.resize(std::max(block_lists.size(), blocks));
     batch_first.resize(count + 1);
     batch_first[0] = 0;
-    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
       std::vector<Sweep_neighbor> list;
-      for (std::size_t q = b; q < e; ++q) {
-        list_of(q, list);
-        batch_first[q + 1] = list.size(); // the count, for now
+      for (std::size_t blk = bb; blk < be; ++blk) {
+        std::vector<Sweep_neighbor>& out = block_lists[blk];
+        out.clear();
+        for (std::size_t q = blk * block; q < std::min(count, (blk + 1) * block); ++q) {
+          list_of(q, list);
+          batch_first[q + 1] = list.size(); // the count, for now
+          out.insert(out.end(), list.begin(), list.end());
+        }
       }
-    }, 1024);
+    }, 1);
     for (std::size_t q = 0; q < count; ++q)
       batch_first[q + 1] += batch_first[q];
     batch_neighbors.resize(batch_first[count]);
-    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
-      std::vector<Sweep_neighbor> list;
-      for (std::size_t q = b; q < e; ++q) {
-        list_of(q, list);
-        std::copy(list.begin(), list.end(), batch_neighbors.begin() + std::ptrdiff_t(batch_first[q]));
-      }
-    }, 1024);
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
+      for (std::size_t blk = bb; blk < be; ++blk)
+        std::copy(block_lists[blk].begin(), block_lists[blk].end(),
+                  batch_neighbors.begin() + std::ptrdiff_t(batch_first[blk * block]));
+    }, 1);
     report.number_of_edges += batch_neighbors.size();
     if constexpr (internal::Has_prepare<Visitor, Sweep_window<Payload>>::value)
       visitor.prepare(window, job.first, batch_first, batch_neighbors);
