@@ -208,7 +208,7 @@ void expect_identical(const std::vector<Point_record>& a, const std::vector<Poin
 ns::External_sort_options options_with(std::size_t records_per_run, const std::string& directory)
 {
   ns::External_sort_options options;
-  options.memory_budget = records_per_run * sizeof(ns::internal::Keyed_record);
+  options.memory_budget = records_per_run * ns::External_sort_options::bytes_per_record;
   options.temporary_directory = directory;
   return options;
 }
@@ -535,7 +535,10 @@ TEST(Temporary_files, AppearDuringSortAndVanishAfter)
   source.on_read = [&](std::size_t) { most_files = std::max(most_files, directory.count()); };
   {
     ns::Sorted_run_reader reader = ns::external_sort(source, frame, options_with(3000, directory.path()));
-    EXPECT_EQ(most_files, 6u); // the 7th run is written after the last read
+    // the 7th run is written after the last read; the 6th may still be
+    // being written by the sort's thread when the last read happens
+    EXPECT_GE(most_files, 5u);
+    EXPECT_LE(most_files, 6u);
     EXPECT_EQ(directory.count(), 7u);
     ns::Sorted_run_reader moved = std::move(reader);
     EXPECT_EQ(directory.count(), 7u);
@@ -576,7 +579,7 @@ TEST(Temporary_files, ThrowingSourceLeavesNothing)
       throw std::runtime_error("disk on fire");
   };
   EXPECT_THROW(ns::external_sort(source, frame, options_with(2000, directory.path())), std::runtime_error);
-  EXPECT_GE(most_files, 5u);
+  EXPECT_GE(most_files, 4u); // 5 runs written by then, the last one perhaps still in progress
   EXPECT_EQ(directory.count(), 0u);
   // also during an intermediate merge's lifetime
   ns::External_sort_options options = options_with(500, directory.path());
@@ -802,7 +805,7 @@ TEST(Streaming_presorted, SameOrientationAsTheSortedPath)
   Vector_source source(shuffled);
   NO::Streaming_options options = streaming_options_in(directory.path());
   options.batch_size = 2000;
-  options.sort.memory_budget = 5000 * sizeof(ns::internal::Keyed_record); // several runs
+  options.sort.memory_budget = 5000 * ns::External_sort_options::bytes_per_record; // several runs
   std::vector<Point_record> reference;
   const NO::Streaming_result ref = stream(source, options, reference);
   ASSERT_EQ(reference.size(), n);
@@ -821,7 +824,7 @@ TEST(Streaming_presorted, SameOrientationAsTheSortedPath)
     Vector_source presorted(sorted_by(cloud.records, axis));
     NO::Streaming_options po = options;
     po.presorted_axis = axes[axis];
-    po.sort.memory_budget = 16 * sizeof(ns::internal::Keyed_record); // would make runs: it must not sort
+    po.sort.memory_budget = 16 * ns::External_sort_options::bytes_per_record; // would make runs: it must not sort
     std::size_t most_files = 0;
     presorted.on_read = [&](std::size_t) { most_files = std::max(most_files, directory.count()); };
     std::vector<Point_record> out;
@@ -1057,7 +1060,7 @@ TEST(Streaming_progress, ReportsEveryStageInOrderAndCancels)
   const std::size_t n = cloud.records.size();
   NO::Streaming_options options = streaming_options_in(directory.path());
   options.batch_size = 300;
-  options.sort.memory_budget = 1000 * sizeof(ns::internal::Keyed_record);
+  options.sort.memory_budget = 1000 * ns::External_sort_options::bytes_per_record;
   std::vector<NO::Streaming_progress> log;
   options.callback = [&log](const NO::Streaming_progress& p) {
     log.push_back(p);
@@ -1183,7 +1186,7 @@ TEST(Streaming_window, PeakDoesNotGrowWithTheLength)
       Vector_source source(presorted ? sorted_by(cloud.records, 0) : cloud.records);
       NO::Streaming_options options = streaming_options_in(directory.path());
       options.batch_size = 1000; // the window is a slab of about 3r, plus a batch and a read
-      options.sort.memory_budget = 20000 * sizeof(ns::internal::Keyed_record);
+      options.sort.memory_budget = 20000 * ns::External_sort_options::bytes_per_record;
       if (presorted)
         options.presorted_axis = NO::Presorted_axis::X;
       std::vector<Point_record> out;
@@ -1376,7 +1379,7 @@ TEST(Streaming_faults, DiskFullHalfWayLeavesNothing)
 
   NO::Streaming_options options = streaming_options_in(temporary.path());
   options.batch_size = 2000;                                       // progress per batch of the sweep
-  options.sort.memory_budget = 4000 * sizeof(ns::internal::Keyed_record); // 10 runs of 224 kB
+  options.sort.memory_budget = 4000 * ns::External_sort_options::bytes_per_record; // 10 runs of 224 kB
   options.component_files.directory = files.file("parts");
   const struct
   {

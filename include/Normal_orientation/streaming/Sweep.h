@@ -302,17 +302,22 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
   int current = 0;
   bool pending = false; // jobs[1 - current] is searched, not yet finalised
 
-  // reverse edges: (later end, earlier end, squared distance)
+  // A reverse edge: an edge found by the earlier end's query, handed to its
+  // later end (`target`), whose source is `target - back`.
   struct Reverse
   {
-    std::uint64_t target, source;
+    std::uint64_t target;
+    std::uint32_t back;
     float squared_distance;
   };
-  std::vector<Reverse> reverse, bucketed;
+  const std::size_t block = 1024; // points per block of the parallel steps (fixed: determinism)
+  std::vector<Reverse> carry, next_carry; // reverse edges to points after the batch being finalised
+  std::vector<std::vector<Reverse>> block_reverse; // per block of a batch: its reverse edges
+  std::vector<Reverse> bucketed; // the reverse edges to the batch's points, by target
   std::vector<std::size_t> batch_first;
   std::vector<Sweep_neighbor> batch_neighbors;
-  std::vector<std::vector<Sweep_neighbor>> block_lists; // per block of 1024 points of a batch
-  std::vector<std::size_t> bucket_start, bucket_begin;
+  std::vector<std::vector<Sweep_neighbor>> block_lists; // per block of a batch
+  std::vector<std::size_t> bucket_begin;
   std::vector<Point> points;
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed; // (Morton code, slot), sorted
   std::vector<std::uint32_t> queries;                          // tree positions of the batch
@@ -423,76 +428,99 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
   // whose front may have moved since the search) and releases what no
   // later point can need.
   auto finish = [&](Job& job) {
-    const std::size_t count = job.count;
-    // 1. Reverse edges from this batch to later points.
-    for (std::size_t q = 0; q < count; ++q)
-      for (unsigned int t = 0; t < k; ++t) {
-        const std::uint32_t j = job.knn[q * k + t];
-        if (j == ~std::uint32_t(0) || !(double(job.knn_d2[q * k + t]) < r2))
-          continue;
-        const std::uint64_t sj = job.base + j, sp = job.first + q;
-        if (sj > sp)
-          reverse.push_back({sj, sp, job.knn_d2[q * k + t]});
-      }
-    // Bucket them by target (a stable counting sort over the targets still
-    // in the window, all at or after `finalized`); the order within a
-    // target does not matter, the lists are sorted per point below.
-    {
-      const std::size_t span = std::size_t(window.m_base + slots.size() - finalized);
-      bucket_start.assign(span + 1, 0);
-      for (const Reverse& e : reverse)
-        ++bucket_start[std::size_t(e.target - finalized) + 1];
-      for (std::size_t b = 0; b < span; ++b)
-        bucket_start[b + 1] += bucket_start[b];
-      bucket_begin.assign(bucket_start.begin(), bucket_start.begin() + std::ptrdiff_t(std::min(span, count) + 1));
-      bucketed.resize(reverse.size());
-      for (const Reverse& e : reverse)
-        bucketed[bucket_start[std::size_t(e.target - finalized)]++] = e;
-      reverse.swap(bucketed);
+    const std::size_t count = job.count, blocks = (count + block - 1) / block;
+    if (block_reverse.size() < blocks) {
+      block_reverse.resize(blocks);
+      block_lists.resize(blocks);
     }
+    // 1. The reverse edges of the batch (to later points), per block, in
+    //    parallel.
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
+      for (std::size_t blk = bb; blk < be; ++blk) {
+        std::vector<Reverse>& out = block_reverse[blk];
+        out.clear();
+        for (std::size_t q = blk * block; q < std::min(count, (blk + 1) * block); ++q) {
+          const std::uint64_t sp = job.first + q;
+          for (unsigned int t = 0; t < k; ++t) {
+            const std::uint32_t j = job.knn[q * k + t];
+            if (j == ~std::uint32_t(0) || !(double(job.knn_d2[q * k + t]) < r2))
+              continue;
+            const std::uint64_t sj = job.base + j;
+            if (sj > sp)
+              out.push_back(Reverse{sj, std::uint32_t(sj - sp), job.knn_d2[q * k + t]});
+          }
+        }
+      }
+    }, 1);
+    // Bucket those to the batch's points by target (a counting sort: the
+    // edges carried from earlier batches, then the blocks in order; the
+    // order within a target does not matter, the lists are sorted per point
+    // below); the others are carried to the next batches.
+    const std::uint64_t end = job.first + count;
+    bucket_begin.assign(count + 1, 0);
+    next_carry.clear();
+    auto count_edge = [&](const Reverse& e) {
+      if (e.target < end)
+        ++bucket_begin[std::size_t(e.target - job.first) + 1];
+      else
+        next_carry.push_back(e);
+    };
+    for (const Reverse& e : carry)
+      count_edge(e);
+    for (std::size_t blk = 0; blk < blocks; ++blk)
+      for (const Reverse& e : block_reverse[blk])
+        count_edge(e);
+    for (std::size_t q = 0; q < count; ++q)
+      bucket_begin[q + 1] += bucket_begin[q];
+    bucketed.resize(bucket_begin[count]);
+    {
+      std::vector<std::size_t>& next = batch_first; // the next free place of each bucket (reused buffer)
+      next.assign(bucket_begin.begin(), bucket_begin.begin() + std::ptrdiff_t(count));
+      auto place = [&](const Reverse& e) {
+        if (e.target < end)
+          bucketed[next[std::size_t(e.target - job.first)]++] = e;
+      };
+      for (const Reverse& e : carry)
+        place(e);
+      for (std::size_t blk = 0; blk < blocks; ++blk)
+        for (const Reverse& e : block_reverse[blk])
+          place(e);
+    }
+    carry.swap(next_carry);
 
     // 2. The earlier neighbours of every point of the batch (sorted by
-    //    sequence number): its own earlier kNN, then the reverse edges of
-    //    bucket q, without duplicates; built in parallel, twice (once to
-    //    count, once to write at the counted offsets).  Then the visitor:
-    //    `prepare` on the whole batch when it has one (it may work in
-    //    parallel), then `finalize` in order.
-    const std::size_t rv = bucket_begin[count]; // the reverse edges of later points start here
-    auto list_of = [&](std::size_t q, std::vector<Sweep_neighbor>& list) {
-      const std::uint64_t sp = job.first + q;
-      list.clear();
-      for (unsigned int t = 0; t < k; ++t) {
-        const std::uint32_t j = job.knn[q * k + t];
-        if (j == ~std::uint32_t(0) || !(double(job.knn_d2[q * k + t]) < r2))
-          continue;
-        const std::uint64_t sj = job.base + j;
-        if (sj < sp)
-          list.push_back(Sweep_neighbor{sj, job.knn_d2[q * k + t]});
-      }
-      for (std::size_t v = bucket_begin[q]; v < bucket_begin[q + 1]; ++v)
-        list.push_back(Sweep_neighbor{reverse[v].source, reverse[v].squared_distance});
-      std::sort(list.begin(), list.end(),
-                [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence < c.sequence; });
-      list.erase(std::unique(list.begin(), list.end(),
-                             [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence == c.sequence; }),
-                 list.end());
-    };
-    // In blocks of fixed size (the result does not depend on the threads):
-    // each block's lists are written to a buffer of its own, then copied
-    // to their place once the counts are known.
-    const std::size_t block = 1024, blocks = (count + block - 1) / block;
-    block_lists.resize(std::max(block_lists.size(), blocks));
+    //    sequence number): its own earlier kNN, then its reverse edges,
+    //    without duplicates; built in parallel, in blocks of fixed size
+    //    (the result does not depend on the threads), each block's lists
+    //    written to a buffer of its own, then copied to their place once the
+    //    counts are known.  Then the visitor: `prepare` on the whole batch
+    //    when it has one (it may work in parallel), then `finalize` in order.
     batch_first.resize(count + 1);
     batch_first[0] = 0;
     Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
-      std::vector<Sweep_neighbor> list;
       for (std::size_t blk = bb; blk < be; ++blk) {
         std::vector<Sweep_neighbor>& out = block_lists[blk];
         out.clear();
         for (std::size_t q = blk * block; q < std::min(count, (blk + 1) * block); ++q) {
-          list_of(q, list);
-          batch_first[q + 1] = list.size(); // the count, for now
-          out.insert(out.end(), list.begin(), list.end());
+          const std::uint64_t sp = job.first + q;
+          const std::size_t from = out.size();
+          for (unsigned int t = 0; t < k; ++t) {
+            const std::uint32_t j = job.knn[q * k + t];
+            if (j == ~std::uint32_t(0) || !(double(job.knn_d2[q * k + t]) < r2))
+              continue;
+            const std::uint64_t sj = job.base + j;
+            if (sj < sp)
+              out.push_back(Sweep_neighbor{sj, job.knn_d2[q * k + t]});
+          }
+          for (std::size_t v = bucket_begin[q]; v < bucket_begin[q + 1]; ++v)
+            out.push_back(Sweep_neighbor{sp - bucketed[v].back, bucketed[v].squared_distance});
+          const auto list = out.begin() + std::ptrdiff_t(from);
+          std::sort(list, out.end(),
+                    [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence < c.sequence; });
+          out.erase(std::unique(list, out.end(),
+                                [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence == c.sequence; }),
+                    out.end());
+          batch_first[q + 1] = out.size() - from; // the count, for now
         }
       }
     }, 1);
@@ -512,7 +540,6 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
                      batch_neighbors.begin() + std::ptrdiff_t(batch_first[q + 1]));
       visitor.finalize(window, job.first + q, earlier);
     }
-    reverse.erase(reverse.begin(), reverse.begin() + std::ptrdiff_t(rv));
     finalized = job.first + count;
     report.number_of_points += count;
 

@@ -42,6 +42,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <future>
 #include <limits>
 #include <memory>
 #include <stdexcept>
@@ -453,15 +454,6 @@ private:
   std::string m_path;
 };
 
-/// a record with its sweep key, the unit of the in-memory run sort (64 bytes)
-struct Keyed_record
-{
-  /// the sweep key of `record`
-  double key;
-  /// the record
-  Point_record record;
-};
-
 /// the sort order: by key (NaN keys last, all equal), then by index.  A strict
 /// weak order even with NaN keys.
 inline bool key_index_less(double key_a, std::uint64_t index_a, double key_b, std::uint64_t index_b)
@@ -477,6 +469,98 @@ inline bool key_index_less(double key_a, std::uint64_t index_a, double key_b, st
   }
   return index_a < index_b;
 }
+
+/// A run of the external sort in memory: the records as read, and one
+/// (key, position) tag per record, which is what is sorted (16 bytes moved
+/// instead of 56); the records are then written, or permuted, in the tags'
+/// order.
+struct Sort_run
+{
+  /// a record's sweep key and its position in `records`
+  struct Tag
+  {
+    double key;
+    std::uint32_t position;
+  };
+  std::vector<Point_record> records;
+  std::vector<Tag> tags;
+
+  void reserve(std::size_t n)
+  {
+    if (records.capacity() < n) {
+      records.reserve(n);
+      tags.reserve(n);
+    }
+  }
+  void append(const std::vector<Point_record>& chunk, const Sweep_frame& frame)
+  {
+    for (const Point_record& r : chunk) {
+      tags.push_back(Tag{frame.key(r), std::uint32_t(records.size())});
+      records.push_back(r);
+    }
+  }
+  /// sorts the tags by (key, index) (`key_index_less`)
+  void sort()
+  {
+    const Point_record* r = records.data();
+    std::sort(tags.begin(), tags.end(), [r](const Tag& a, const Tag& b) {
+      if (a.key < b.key)
+        return true;
+      if (b.key < a.key)
+        return false;
+      // equal keys, or a NaN: the full order (NaN last, then by index)
+      return key_index_less(a.key, r[a.position].index, b.key, r[b.position].index);
+    });
+  }
+  /// writes the records in the order of the sorted tags
+  void write(Temporary_file& file) const
+  {
+    const std::size_t block = 8192;
+    std::vector<Point_record> buffer(std::min(block, tags.size()));
+    for (std::size_t b = 0; b < tags.size(); b += block) {
+      const std::size_t e = std::min(tags.size(), b + block);
+      for (std::size_t i = b; i < e; ++i)
+        buffer[i - b] = records[tags[i].position];
+      file.append(buffer.data(), e - b);
+    }
+  }
+  /// puts the records in the order of the sorted tags, in place (one cycle
+  /// of the permutation at a time; the tags are used up)
+  void permute()
+  {
+    const std::uint32_t done = ~std::uint32_t(0);
+    for (std::size_t i = 0; i < tags.size(); ++i) {
+      if (tags[i].position == done || tags[i].position == i) {
+        tags[i].position = done;
+        continue;
+      }
+      const Point_record first = records[i];
+      std::size_t j = i;
+      for (;;) { // slot j receives the record of tags[j].position
+        const std::size_t from = tags[j].position;
+        tags[j].position = done;
+        if (from == i) {
+          records[j] = first;
+          break;
+        }
+        records[j] = records[from];
+        j = from;
+      }
+    }
+    tags.clear();
+  }
+  void clear()
+  {
+    records.clear();
+    tags.clear();
+  }
+  /// frees the memory
+  void release()
+  {
+    records = std::vector<Point_record>();
+    tags = std::vector<Tag>();
+  }
+};
 
 /// Lazy k-way merge of sorted run files (a binary heap of the run heads): a
 /// source of the merged sequence.  Ties on (key, index) are broken by run order.
@@ -610,12 +694,17 @@ using Normal_orientation::remove_temporary_files;
 /// Options of `External_sorter`.
 struct External_sort_options
 {
-  /// bytes of records sorted in memory at once (a run, at least 16 records);
-  /// each record takes 64 bytes then.  The merge buffers of the reader share
-  /// this budget too (at least 64 records per run).  Peak memory of the sort:
-  /// about 1.25 times this (intermediate merges use a quarter of the budget
-  /// while the run buffer is kept) plus 0.5 MiB.
+  /// bytes of memory for the runs: a run holds `memory_budget /
+  /// bytes_per_record` records (at least 16), read from the source while
+  /// the previous run is sorted and written.  The merge buffers of the
+  /// reader share this budget too (at least 64 records per run).  Peak
+  /// memory of the sort: about 1.25 times this (intermediate merges use a
+  /// quarter of the budget while the runs are kept) plus 0.6 MiB.
   std::size_t memory_budget = std::size_t(256) << 20;
+  /// the bytes of `memory_budget` a record of a run takes: 56 for the
+  /// record and 16 for its sort key and position, twice (the run being read
+  /// and the run being sorted and written)
+  static constexpr std::size_t bytes_per_record = 2 * (sizeof(Point_record) + 16);
   /// where temporary files go; empty: `$TMPDIR` if set, else /tmp
   std::string temporary_directory;
   /// the most runs merged at once (at least 2); more runs are merged in
@@ -674,8 +763,8 @@ public:
     if (m_merger)
       return m_merger->read(chunk, maximum);
     const std::size_t n = std::min(maximum, m_memory.size() - m_memory_position);
-    for (std::size_t i = 0; i < n; ++i)
-      chunk.push_back(m_memory[m_memory_position + i].record);
+    chunk.insert(chunk.end(), m_memory.begin() + std::ptrdiff_t(m_memory_position),
+                 m_memory.begin() + std::ptrdiff_t(m_memory_position + n));
     m_memory_position += n;
     return n;
   }
@@ -702,7 +791,7 @@ private:
 
   Sweep_frame m_frame;
   External_sort_report m_report;
-  std::vector<internal::Keyed_record> m_memory;
+  std::vector<Point_record> m_memory; // the single run, sorted, when it fits in memory
   std::size_t m_memory_position = 0;
   std::vector<std::unique_ptr<internal::Temporary_file>> m_runs;
   std::unique_ptr<internal::Run_merger> m_merger; // after m_runs: destroyed first
@@ -711,9 +800,10 @@ private:
 /// \ingroup PkgNormalOrientationStreaming
 /// Sorts all records of a source by (sweep key, index) with bounded memory.
 ///
-/// The source is read in runs of at most `memory_budget / 64` records; each run
-/// is sorted in memory (`std::sort` of (key, record) pairs) and written to a
-/// temporary file (`mkstemp()` in the temporary directory).  Whenever
+/// The source is read in runs of at most `memory_budget / bytes_per_record`
+/// records; each run is sorted in memory (`std::sort` of (key, position)
+/// tags) and written to a temporary file (`mkstemp()` in the temporary
+/// directory) on a thread of its own while the next run is read.  Whenever
 /// `max_merge_fan_in` runs of the same level exist they are merged into one
 /// (intermediate passes, like a log-structured merge), so at most about
 /// `max_merge_fan_in * levels` files exist at once.  The final k-way merge is
@@ -746,40 +836,47 @@ public:
     External_sort_report& report = result.m_report;
     report.temporary_directory = internal::temporary_directory(m_options.temporary_directory);
 
-    const std::size_t run_capacity =
-      std::max<std::size_t>(m_options.memory_budget / sizeof(internal::Keyed_record), 16);
+    const std::size_t run_capacity = std::min<std::size_t>(
+      std::max<std::size_t>(m_options.memory_budget / External_sort_options::bytes_per_record, 16),
+      std::numeric_limits<std::uint32_t>::max()); // positions in a run are 32-bit
     const std::size_t staging_capacity = std::min<std::size_t>(run_capacity, 8192);
     const std::size_t fan_in = std::max<std::size_t>(m_options.max_merge_fan_in, 2);
 
-    std::vector<Point_record> staging;
-    staging.reserve(staging_capacity);
-    std::vector<internal::Keyed_record> run;
-    run.reserve(staging_capacity);
-    std::vector<Level_run> runs;
-
-    auto write_run = [&]() {
-      std::sort(run.begin(), run.end(), [](const internal::Keyed_record& a, const internal::Keyed_record& b) {
-        return internal::key_index_less(a.key, a.record.index, b.key, b.record.index);
-      });
+    // Two runs: one filled here from the source while the other is sorted
+    // and written on a thread of its own (`flush`), so that reading and
+    // parsing overlap with sorting and writing.
+    internal::Sort_run runs_in_memory[2];
+    internal::Sort_run* filling = &runs_in_memory[0];
+    internal::Sort_run* flushed = &runs_in_memory[1];
+    std::vector<Level_run> runs; // the files; touched by one flush at a time
+    auto flush = [&](internal::Sort_run& run) {
+      run.sort();
       auto file = std::make_unique<internal::Temporary_file>(report.temporary_directory,
                                                              m_options.unlink_on_creation);
-      // pack the records in place (record i moves from byte 64 i + 8 down to byte 56 i,
-      // never over a record not yet moved), then write them in one go
-      unsigned char* bytes = reinterpret_cast<unsigned char*>(run.data());
-      for (std::size_t i = 0; i < run.size(); ++i)
-        std::memmove(bytes + i * sizeof(Point_record), &run[i].record, sizeof(Point_record));
-      file->append(bytes, run.size());
+      run.write(*file);
       report.bytes_written += file->size() * sizeof(Point_record);
       ++report.runs;
       runs.push_back(Level_run{std::move(file), 0});
       run.clear();
       collapse(runs, fan_in, fan_in, frame, report, m_options.memory_budget / 4);
     };
+    std::future<void> flushing;
+    struct Wait // on exceptions too: `flush` uses this frame
+    {
+      std::future<void>& f;
+      ~Wait()
+      {
+        if (f.valid())
+          f.wait();
+      }
+    } wait{flushing};
 
+    std::vector<Point_record> staging;
+    staging.reserve(staging_capacity);
     source.rewind();
     for (;;) {
-      const std::size_t want =
-        run.size() < run_capacity ? std::min(staging_capacity, run_capacity - run.size()) : staging_capacity;
+      const std::size_t size = filling->records.size();
+      const std::size_t want = size < run_capacity ? std::min(staging_capacity, run_capacity - size) : staging_capacity;
       staging.clear();
       const std::size_t n = source.read(staging, want);
       if (n == 0)
@@ -787,25 +884,30 @@ public:
       if (n != staging.size() || n > want)
         throw std::logic_error("External_sorter: the source's read() returned a wrong count");
       report.points += n;
-      if (run.size() == run_capacity)
-        write_run(); // more records than one run: this one goes to a file
-      if (run.capacity() < run.size() + n)
-        run.reserve(run_capacity); // one jump: never more than the budget (plus the first block)
-      for (const Point_record& r : staging)
-        run.push_back(internal::Keyed_record{frame.key(r), r});
+      if (size == run_capacity) { // more records than one run: this one goes to a file
+        if (flushing.valid())
+          flushing.get(); // rethrows a failed write
+        std::swap(filling, flushed);
+        flushing = std::async(std::launch::async, [&flush, flushed]() { flush(*flushed); });
+      }
+      filling->reserve(run_capacity); // once: never more than the budget
+      filling->append(staging, frame);
     }
+    if (flushing.valid())
+      flushing.get();
+    staging = std::vector<Point_record>();
+    flushed->release();
 
     if (runs.empty() && m_options.keep_single_run_in_memory) {
-      std::sort(run.begin(), run.end(), [](const internal::Keyed_record& a, const internal::Keyed_record& b) {
-        return internal::key_index_less(a.key, a.record.index, b.key, b.record.index);
-      });
-      report.runs = run.empty() ? 0 : 1;
-      result.m_memory = std::move(run);
+      filling->sort();
+      filling->permute();
+      report.runs = filling->records.empty() ? 0 : 1;
+      result.m_memory = std::move(filling->records);
     }
     else {
-      if (!run.empty())
-        write_run();
-      std::vector<internal::Keyed_record>().swap(run);
+      if (!filling->records.empty())
+        flush(*filling);
+      filling->release();
       collapse(runs, fan_in, 1, frame, report, m_options.memory_budget); // at most fan_in runs for the reader
       std::vector<const internal::Temporary_file*> files;
       for (Level_run& r : runs) {
