@@ -11,6 +11,7 @@
 /// edges `build_neighbor_graph()` would give in core.
 
 #include <Normal_orientation/Neighbor_graph.h>
+#include <Normal_orientation/internal/Future_waiter.h>
 #include <Normal_orientation/streaming/Point_record.h>
 
 #include <CGAL/Kd_tree.h>
@@ -433,25 +434,35 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
       block_reverse.resize(blocks);
       block_lists.resize(blocks);
     }
-    // 1. The reverse edges of the batch (to later points), per block, in
-    //    parallel.
-    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
-      for (std::size_t blk = bb; blk < be; ++blk) {
-        std::vector<Reverse>& out = block_reverse[blk];
-        out.clear();
-        for (std::size_t q = blk * block; q < std::min(count, (blk + 1) * block); ++q) {
-          const std::uint64_t sp = job.first + q;
-          for (unsigned int t = 0; t < k; ++t) {
-            const std::uint32_t j = job.knn[q * k + t];
-            if (j == ~std::uint32_t(0) || !(double(job.knn_d2[q * k + t]) < r2))
-              continue;
-            const std::uint64_t sj = job.base + j;
-            if (sj > sp)
-              out.push_back(Reverse{sj, std::uint32_t(sj - sp), job.knn_d2[q * k + t]});
-          }
-        }
+    // body(blk, b, e) for the points [b, e) of every block, in parallel
+    // (fixed blocks: the result does not depend on the threads)
+    auto for_each_block = [&](const auto& body) {
+      Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
+        for (std::size_t blk = bb; blk < be; ++blk)
+          body(blk, blk * block, std::min(count, (blk + 1) * block));
+      }, 1);
+    };
+    // f(sj, d2) for the neighbours sj of point first + q found by its query
+    // and closer than r
+    auto for_each_found = [&](std::size_t q, const auto& f) {
+      for (unsigned int t = 0; t < k; ++t) {
+        const std::uint32_t j = job.knn[q * k + t];
+        if (j != ~std::uint32_t(0) && double(job.knn_d2[q * k + t]) < r2)
+          f(job.base + j, job.knn_d2[q * k + t]);
       }
-    }, 1);
+    };
+    // 1. The reverse edges of the batch (to later points), per block.
+    for_each_block([&](std::size_t blk, std::size_t b, std::size_t e) {
+      std::vector<Reverse>& out = block_reverse[blk];
+      out.clear();
+      for (std::size_t q = b; q < e; ++q) {
+        const std::uint64_t sp = job.first + q;
+        for_each_found(q, [&](std::uint64_t sj, float d2) {
+          if (sj > sp)
+            out.push_back(Reverse{sj, std::uint32_t(sj - sp), d2});
+        });
+      }
+    });
     // Bucket those to the batch's points by target (a counting sort: the
     // edges carried from earlier batches, then the blocks in order; the
     // order within a target does not matter, the lists are sorted per point
@@ -497,41 +508,34 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
     //    when it has one (it may work in parallel), then `finalize` in order.
     batch_first.resize(count + 1);
     batch_first[0] = 0;
-    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
-      for (std::size_t blk = bb; blk < be; ++blk) {
-        std::vector<Sweep_neighbor>& out = block_lists[blk];
-        out.clear();
-        for (std::size_t q = blk * block; q < std::min(count, (blk + 1) * block); ++q) {
-          const std::uint64_t sp = job.first + q;
-          const std::size_t from = out.size();
-          for (unsigned int t = 0; t < k; ++t) {
-            const std::uint32_t j = job.knn[q * k + t];
-            if (j == ~std::uint32_t(0) || !(double(job.knn_d2[q * k + t]) < r2))
-              continue;
-            const std::uint64_t sj = job.base + j;
-            if (sj < sp)
-              out.push_back(Sweep_neighbor{sj, job.knn_d2[q * k + t]});
-          }
-          for (std::size_t v = bucket_begin[q]; v < bucket_begin[q + 1]; ++v)
-            out.push_back(Sweep_neighbor{sp - bucketed[v].back, bucketed[v].squared_distance});
-          const auto list = out.begin() + std::ptrdiff_t(from);
-          std::sort(list, out.end(),
-                    [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence < c.sequence; });
-          out.erase(std::unique(list, out.end(),
-                                [](const Sweep_neighbor& a, const Sweep_neighbor& c) { return a.sequence == c.sequence; }),
-                    out.end());
-          batch_first[q + 1] = out.size() - from; // the count, for now
-        }
+    for_each_block([&](std::size_t blk, std::size_t b, std::size_t e) {
+      std::vector<Sweep_neighbor>& out = block_lists[blk];
+      out.clear();
+      for (std::size_t q = b; q < e; ++q) {
+        const std::uint64_t sp = job.first + q;
+        const std::size_t from = out.size();
+        for_each_found(q, [&](std::uint64_t sj, float d2) {
+          if (sj < sp)
+            out.push_back(Sweep_neighbor{sj, d2});
+        });
+        for (std::size_t v = bucket_begin[q]; v < bucket_begin[q + 1]; ++v)
+          out.push_back(Sweep_neighbor{sp - bucketed[v].back, bucketed[v].squared_distance});
+        const auto list = out.begin() + std::ptrdiff_t(from);
+        std::sort(list, out.end(),
+                  [](const Sweep_neighbor& x, const Sweep_neighbor& y) { return x.sequence < y.sequence; });
+        out.erase(std::unique(list, out.end(),
+                              [](const Sweep_neighbor& x, const Sweep_neighbor& y) { return x.sequence == y.sequence; }),
+                  out.end());
+        batch_first[q + 1] = out.size() - from; // the count, for now
       }
-    }, 1);
+    });
     for (std::size_t q = 0; q < count; ++q)
       batch_first[q + 1] += batch_first[q];
     batch_neighbors.resize(batch_first[count]);
-    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
-      for (std::size_t blk = bb; blk < be; ++blk)
-        std::copy(block_lists[blk].begin(), block_lists[blk].end(),
-                  batch_neighbors.begin() + std::ptrdiff_t(batch_first[blk * block]));
-    }, 1);
+    for_each_block([&](std::size_t blk, std::size_t b, std::size_t) {
+      std::copy(block_lists[blk].begin(), block_lists[blk].end(),
+                batch_neighbors.begin() + std::ptrdiff_t(batch_first[b]));
+    });
     report.number_of_edges += batch_neighbors.size();
     if constexpr (internal::Has_prepare<Visitor, Sweep_window<Payload>>::value)
       visitor.prepare(window, job.first, batch_first, batch_neighbors);
@@ -613,15 +617,7 @@ Sweep_report sweep(Source& source, KeyFunction key, const Sweep_options& options
         finish(jobs[1 - current]);
     } else {
       std::future<double> searching = std::async(std::launch::async, [&]() { return search(job); });
-      struct Wait // on exceptions too: `search` uses this frame
-      {
-        std::future<double>& f;
-        ~Wait()
-        {
-          if (f.valid())
-            f.wait();
-        }
-      } wait{searching};
+      const Normal_orientation::internal::Future_waiter<double> wait{searching}; // on exceptions too: `search` uses this frame
       if (pending)
         finish(jobs[1 - current]);
       report.seconds_neighbors += searching.get();

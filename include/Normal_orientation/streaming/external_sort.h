@@ -55,6 +55,7 @@
 #include <sys/types.h>
 #include <unistd.h>
 
+#include <Normal_orientation/internal/Future_waiter.h>
 #include <Normal_orientation/internal/Temporary_files.h>
 
 namespace Normal_orientation {
@@ -861,15 +862,7 @@ public:
       collapse(runs, fan_in, fan_in, frame, report, m_options.memory_budget / 4);
     };
     std::future<void> flushing;
-    struct Wait // on exceptions too: `flush` uses this frame
-    {
-      std::future<void>& f;
-      ~Wait()
-      {
-        if (f.valid())
-          f.wait();
-      }
-    } wait{flushing};
+    const Normal_orientation::internal::Future_waiter<void> wait{flushing}; // on exceptions too: `flush` uses this frame
 
     std::vector<Point_record> staging;
     staging.reserve(staging_capacity);
