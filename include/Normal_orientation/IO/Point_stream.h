@@ -31,6 +31,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <system_error>
 #include <utility>
@@ -240,6 +241,29 @@ private:
 /// \brief Largest PLY header read by `Point_stream_reader`, in bytes.
 constexpr std::size_t max_streamed_ply_header_size = std::size_t(1) << 20;
 
+/// \brief Layout of a PLY file as `Point_stream_reader` found it in the header, for the
+/// code that works on the bytes of the file itself (`transcode_with_flips()`).
+struct Ply_stream_layout
+{
+  /// Encoding of the data.
+  Ply_format format = Ply_format::ASCII;
+  /// The elements declared by the header, in file order.
+  std::vector<Ply_header_element> elements;
+  /// Index of the element `vertex` in `elements`.
+  std::size_t vertex_element = 0;
+  /// Role of each property of `vertex`, as `assign_vertex_roles()` gives them: `0..2` for
+  /// `x y z`, `3..5` for `nx ny nz`, 6 and above for the other properties.
+  std::vector<std::size_t> roles;
+  /// Binary data: byte offset of each property of `vertex` in a row.
+  std::vector<std::size_t> offsets;
+  /// Binary data: bytes per vertex row.
+  std::size_t row_size = 0;
+  /// Bytes of the header, its `end_header` line included: the data start there.
+  std::uint64_t header_size = 0;
+  /// Byte offset of the first vertex row (after the data of the elements before `vertex`).
+  std::uint64_t vertex_data_offset = 0;
+};
+
 } // namespace internal
 
 /// \brief Sequential reader of a point cloud file, chunk by chunk, with a buffer of
@@ -329,6 +353,33 @@ public:
   /// \brief Size of the reading buffer in bytes: the memory used for the data, which
   /// does not depend on the size of the file.
   std::size_t buffer_capacity() const { return input_->capacity(); }
+
+  /// \brief Size of the file in bytes when it was opened.
+  std::uint64_t file_size() const { return input_->file_size(); }
+
+  /// \brief Layout of a PLY file as read from its header (elements, vertex properties and
+  /// their roles, row size and property offsets of binary data, byte offsets of the end
+  /// of the header and of the first vertex row); no value for a `.xyz`/`.pwn` file. For
+  /// code that reads or copies the bytes of the file itself, such as
+  /// `transcode_with_flips()`.
+  std::optional<internal::Ply_stream_layout> ply_layout() const
+  {
+    if(format_ != Format::PLY) return std::nullopt;
+    internal::Ply_stream_layout layout;
+    layout.format = ply_format_;
+    layout.elements = elements_;
+    layout.vertex_element = vertex_element_;
+    layout.roles = roles_;
+    std::size_t offset = 0;
+    for(const internal::Ply_header_property& property : elements_[vertex_element_].properties) {
+      layout.offsets.push_back(offset);
+      offset += ply_scalar_type_size(property.type);
+    }
+    layout.row_size = row_size_;
+    layout.header_size = header_size_;
+    layout.vertex_data_offset = data_offset_;
+    return layout;
+  }
 
   /// \brief Reads up to `maximum` records and appends them to `chunk`; returns their
   /// number, which is 0 only at the end of the data (or if `maximum` is 0). Records
@@ -472,6 +523,8 @@ private:
     const Ply_header header = parse_ply_header(filename_, text.data(), text.data() + text.size());
     elements_ = header.elements;
     vertex_element_ = header.vertex_element;
+    ply_format_ = header.format;
+    header_size_ = static_cast<std::uint64_t>(header.data_begin - text.data());
     binary_ = header.format != Ply_format::ASCII;
     swap_ = (header.format == Ply_format::BINARY_LITTLE_ENDIAN) != host_is_little_endian();
     const Ply_header_element& vertex = elements_[vertex_element_];
@@ -680,6 +733,8 @@ private:
   // PLY
   std::vector<internal::Ply_header_element> elements_;
   std::size_t vertex_element_ = 0;
+  internal::Ply_format ply_format_ = internal::Ply_format::ASCII;
+  std::uint64_t header_size_ = 0; // bytes of the header
   bool binary_ = false;
   bool swap_ = false;
   std::vector<std::size_t> roles_;      // role of each vertex property (see assign_vertex_roles)
