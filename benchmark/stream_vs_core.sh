@@ -8,10 +8,12 @@
 # asks for at most 0.5 at 200k points).
 #
 # usage: stream_vs_core.sh BUILD_DIR [--points N] [--noise a,b,...] [--seed S]
-#                          [--meshes FILES...] [--ours-args "..."]
+#                          [--meshes FILES...] [--ours-args "..."] [--stream-args "..."]
+# (--ours-args go to both runs, --stream-args only to the streamed one, e.g.
+# "--refine 0")
 set -euo pipefail
 if [[ $# -lt 1 || ! -d "$1" ]]; then
-  echo "usage: stream_vs_core.sh BUILD_DIR [--points N] [--noise a,b,...] [--seed S] [--meshes FILES...] [--ours-args \"...\"]" >&2
+  echo "usage: stream_vs_core.sh BUILD_DIR [--points N] [--noise a,b,...] [--seed S] [--meshes FILES...] [--ours-args \"...\"] [--stream-args \"...\"]" >&2
   exit 2
 fi
 build=$1
@@ -20,6 +22,7 @@ points=200000
 noise=0,0.001
 seed=1
 args=""
+stream_args=""
 meshes=()
 while [[ $# -gt 0 ]]; do
   case $1 in
@@ -27,6 +30,7 @@ while [[ $# -gt 0 ]]; do
     --noise) noise=$2; shift 2 ;;
     --seed) seed=$2; shift 2 ;;
     --ours-args) args=$2; shift 2 ;;
+    --stream-args) stream_args=$2; shift 2 ;;
     --meshes) shift; while [[ $# -gt 0 && $1 != --* ]]; do meshes+=("$1"); shift; done ;;
     *) echo "stream_vs_core.sh: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -52,7 +56,7 @@ for mesh in "${meshes[@]}"; do
     # shellcheck disable=SC2086
     "$ours" --quiet $args "$work/c.xyz" "$work/core.ply"
     # shellcheck disable=SC2086
-    segments=$("$ours" --quiet --json --stream $args "$work/c.xyz" "$work/stream.ply" |
+    segments=$("$ours" --quiet --json --stream $args $stream_args "$work/c.xyz" "$work/stream.ply" |
                sed -E 's/.*"segments": ([0-9]+).*/\1/')
     wc=$(wrong "$mesh" "$work/core.ply")
     ws=$(wrong "$mesh" "$work/stream.ply")

@@ -20,6 +20,7 @@
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
 #include <Normal_orientation/streaming/Point_record.h>
 #include <Normal_orientation/streaming/Record_file.h>
+#include <Normal_orientation/streaming/Refinement.h>
 #include <Normal_orientation/streaming/Segmenter.h>
 #include <Normal_orientation/streaming/Sweep.h>
 #include <Normal_orientation/streaming/external_sort.h>
@@ -37,6 +38,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <random>
@@ -71,6 +73,7 @@ enum class Streaming_stage
   SORT,      ///< the external sort along the principal axis (not with a presorted input)
   SWEEP,     ///< the sweep: neighbour graph, edge weights, segmentation
   SOLVE,     ///< the solver on the segment graph
+  REFINE,    ///< the refinement passes (only with `Streaming_options::refinement`.rounds > 0)
   SIGN,      ///< the outward sign of every component (passes over the record file)
   OUTPUT,    ///< the oriented points handed to the sink
   COMPONENTS ///< the files of the components (only with `Streaming_options::component_files`)
@@ -78,7 +81,7 @@ enum class Streaming_stage
 
 /// \ingroup PkgNormalOrientationStreaming
 /// The lower-case name of `stage` ("scan", "radius", "sort", "sweep",
-/// "solve", "sign", "output", "components").
+/// "solve", "refine", "sign", "output", "components").
 /// \param stage the stage
 /// \return a string literal
 inline const char* streaming_stage_name(Streaming_stage stage)
@@ -94,6 +97,8 @@ inline const char* streaming_stage_name(Streaming_stage stage)
     return "sweep";
   case Streaming_stage::SOLVE:
     return "solve";
+  case Streaming_stage::REFINE:
+    return "refine";
   case Streaming_stage::SIGN:
     return "sign";
   case Streaming_stage::OUTPUT:
@@ -114,7 +119,7 @@ struct Streaming_progress
   /// the stage running
   Streaming_stage stage = Streaming_stage::SCAN;
   /// the units of work of the stage done so far (points, or points times
-  /// passes; for `SOLVE`, 0 then 1)
+  /// passes, as in `SIGN` and `REFINE`; for `SOLVE`, 0 then 1)
   std::uint64_t done = 0;
   /// the units of work of the stage, 0 when unknown (the scan, which counts
   /// the points)
@@ -158,9 +163,18 @@ struct Streaming_options
   /// r; 0 to estimate it from a uniform sample of the cloud (see
   /// `streaming_orient_normals()`)
   double radius = 0.0;
-  /// the segmentation thresholds (the paper's defaults: theta_S = 0,
-  /// theta_acc = 0.5)
+  /// the segmentation thresholds of the sweep (the paper's defaults:
+  /// theta_S = 0, theta_acc = 0.5)
   streaming::Segmentation_thresholds thresholds;
+  /// The refinement after the segment graph is solved (see
+  /// `streaming::Refinement_options`): rounds of re-segmentation around the
+  /// current labelling, with finer and finer segments, each solved again,
+  /// and single-point moves, in passes over the points in the sweep order
+  /// with a window of bounded size.  It never raises the energy of the
+  /// point graph.  It needs the edges of the graph: the sweep writes them
+  /// to a temporary file of 8 bytes per edge (about 56 bytes per point with
+  /// k = 12, next to the 64 of the record file).  `rounds = 0` turns it off.
+  streaming::Refinement_options refinement;
   /// points finalised per batch of the sweep
   std::size_t batch_size = std::size_t(1) << 18;
   /// the external sort (memory budget, temporary directory)
@@ -216,6 +230,20 @@ struct Streaming_result
   bool presorted = false;               ///< the input was read as presorted (no principal axis, no sort)
   double segment_energy_before = 0.0;   ///< energy of the segment graph, preliminary orientation
   double segment_energy_after = 0.0;    ///< energy of the segment graph after the solver
+  /// energy of the point graph (every edge, as in core) with the labelling
+  /// of the segment graph's solution, before the refinement
+  double energy_before_refinement = 0.0;
+  /// energy of the point graph after the refinement (the final labelling,
+  /// up to the free sign of each component); never above
+  /// `energy_before_refinement`, equal to it without refinement
+  double energy_after_refinement = 0.0;
+  /// the rounds of the refinement whose new segment graph lowered the energy
+  unsigned int refinement_rounds_accepted = 0;
+  /// the single-point moves of the refinement, over all its passes
+  std::uint64_t refinement_moves = 0;
+  /// the most points back, in the sweep order, that an edge reaches: the
+  /// refinement holds twice as many points at once
+  std::uint64_t edge_span = 0;
   std::uint64_t number_of_flipped = 0;  ///< normals handed to the sink whose sign changed
   /// the component files written, by rank (largest component first)
   std::vector<std::string> component_files;
@@ -226,7 +254,8 @@ struct Streaming_result
     /// @{
     /// wall-clock seconds of the stage of that name (see `Streaming_stage`;
     /// `total`: the whole call)
-    double frame = 0, radius = 0, sort = 0, sweep = 0, solve = 0, sign = 0, output = 0, components = 0, total = 0;
+    double frame = 0, radius = 0, sort = 0, sweep = 0, solve = 0, refine = 0, sign = 0, output = 0, components = 0,
+           total = 0;
     /// @}
   } seconds; ///< seconds per stage
 };
@@ -604,6 +633,12 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   t = Clock::now();
   report(Streaming_stage::SWEEP, 0, n);
   streaming::Record_file<internal::Swept_record> records(options.temporary_directory);
+  const bool refine = options.refinement.rounds > 0;
+  // for the refinement, the earlier edges of every point in the sweep order,
+  // each point's after a header entry whose offset is their number
+  std::unique_ptr<streaming::Record_file<streaming::Earlier_edge>> edges;
+  if (refine)
+    edges = std::make_unique<streaming::Record_file<streaming::Earlier_edge>>(options.temporary_directory, 1 << 16);
   streaming::Segmenter segmenter(options.thresholds);
   std::vector<std::uint64_t> segment_size;
   const double r2 = radius * radius;
@@ -612,11 +647,13 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     const FlipCriterion& criterion;
     streaming::Segmenter& segmenter;
     streaming::Record_file<internal::Swept_record>& records;
+    streaming::Record_file<streaming::Earlier_edge>* edges;
     std::vector<std::uint64_t>& segment_size;
     double r2;
     const internal::Streaming_reporter& report;
     std::uint64_t n;
     std::vector<streaming::Neighbor_vote> votes;
+    std::uint64_t span = 0; // the farthest back an edge reaches
 
     // The edge weights of a whole batch, in parallel, with the input
     // normals (as in the in-core graph, in single precision); the
@@ -650,9 +687,20 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
                   const std::vector<streaming::Sweep_neighbor>& earlier)
     {
       votes.clear();
+      if (edges != nullptr) { // a header (the number of edges), then the edges
+        const std::uint64_t farthest = earlier.empty() ? 0 : s - earlier.front().sequence; // sorted
+        if (farthest > std::uint64_t(std::numeric_limits<std::uint32_t>::max()) ||
+            earlier.size() > std::size_t(std::numeric_limits<std::uint32_t>::max()))
+          throw std::length_error("streaming_orient_normals: the sweep window is too large for the refinement");
+        span = std::max(span, farthest);
+        edges->append(streaming::Earlier_edge{std::uint32_t(earlier.size()), 0.0f});
+      }
       for (const streaming::Sweep_neighbor& nb : earlier) {
         const internal::Sweep_payload& pq = w.payload(nb.sequence);
-        votes.push_back({pq.segment, double(weights[cursor++]) * double(pq.flip)});
+        const float weight = weights[cursor++];
+        votes.push_back({pq.segment, double(weight) * double(pq.flip)});
+        if (edges != nullptr)
+          edges->append(streaming::Earlier_edge{std::uint32_t(s - nb.sequence), weight});
       }
       const streaming::Segment_assignment a = segmenter.add_point(votes);
       w.payload(s) = internal::Sweep_payload{a.segment, a.flip};
@@ -664,7 +712,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     {
       records.append(internal::Swept_record{w.record(s), w.payload(s).segment, std::int32_t(w.payload(s).flip)});
     }
-  } visitor{criterion, segmenter, records, segment_size, r2, report, n, {}, {}, 0};
+  } visitor{criterion, segmenter, records, edges.get(), segment_size, r2, report, n, {}, 0, {}, 0};
   streaming::Sweep_window<internal::Sweep_payload> window;
   streaming::Sweep_options so;
   so.number_of_neighbors = k;
@@ -679,9 +727,12 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   if (presorted)
     source.rewind();
   records.rewind();
+  if (edges)
+    edges->rewind();
   result.number_of_points = sr.number_of_points;
   result.number_of_edges = sr.number_of_edges;
   result.peak_window = sr.peak_window;
+  result.edge_span = visitor.span;
   report(Streaming_stage::SWEEP, n, n);
   result.seconds.sweep = since(t);
 
@@ -712,6 +763,88 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   report(Streaming_stage::SOLVE, 1, 1);
   result.seconds.solve = since(t);
 
+  // 5b. The refinement: rounds of one pass over the points (single-point
+  //     moves, then segmentation around the new labelling) and one solve of
+  //     the new segment graph.  The labels of a pass come from the record
+  //     file (preliminary flip times the segment's label) in the first
+  //     round, then from the label file of the previous round (label times
+  //     the label of its new segment); so do the final labels.
+  //     It is skipped when no edge contradicts the labelling (its energy,
+  //     known from the segment graph, is 0): nothing could improve it.
+  std::unique_ptr<streaming::Record_file<std::uint32_t>> final_labels;
+  std::vector<Label> final_segment_label; // the labels of the segments of `final_labels`
+  result.energy_before_refinement = segmenter.point_energy(x);
+  result.energy_after_refinement = result.energy_before_refinement;
+  if (refine) {
+    t = Clock::now();
+    const unsigned int rounds = result.energy_before_refinement > 0.0 ? options.refinement.rounds : 0;
+    const std::uint64_t total = std::uint64_t(options.refinement.rounds) * n;
+    const bool prefetch = std::is_convertible<ConcurrencyTag, CGAL::Parallel_tag>::value;
+    report(Streaming_stage::REFINE, 0, total);
+    std::vector<Label> segment_label; // the labels of the segments of the label file read
+    std::unique_ptr<streaming::Record_file<std::uint32_t>> in, out;
+    std::uint64_t done = 0;
+    for (unsigned int round = 0; round < rounds; ++round) {
+      streaming::Segmentation_thresholds theta = options.refinement.thresholds;
+      theta.maximum_size = options.refinement.maximum_segment_size(n, round);
+      streaming::Segmenter resegmenter(theta, false);
+      out = std::make_unique<streaming::Record_file<std::uint32_t>>(options.temporary_directory, 1 << 16);
+      streaming::internal::Relabelling_window pass(result.edge_span, &resegmenter, false);
+      auto write = [&out](Label label, std::uint32_t segment) {
+        if (segment > (std::numeric_limits<std::uint32_t>::max() >> 1))
+          throw std::length_error("streaming_orient_normals: too many segments in the refinement");
+        out->append((segment << 1) | (label < 0 ? 1u : 0u));
+      };
+      streaming::internal::Edge_reader edge_reader(*edges, prefetch);
+      const streaming::Earlier_edge* point_edges = nullptr;
+      std::size_t count = 0;
+      if (round == 0) {
+        streaming::internal::Record_reader<internal::Swept_record> reader(records, std::size_t(1) << 15, prefetch);
+        while (true) {
+          const std::vector<internal::Swept_record>& chunk = reader.next();
+          if (chunk.empty())
+            break;
+          for (const internal::Swept_record& s : chunk) {
+            edge_reader.next(point_edges, count);
+            pass.push(Label(s.flip * x[s.segment]), point_edges, count, write);
+          }
+          done += chunk.size();
+          report(Streaming_stage::REFINE, done, total);
+        }
+      } else {
+        streaming::internal::Record_reader<std::uint32_t> reader(*in, std::size_t(1) << 16, prefetch);
+        while (true) {
+          const std::vector<std::uint32_t>& chunk = reader.next();
+          if (chunk.empty())
+            break;
+          for (const std::uint32_t word : chunk) {
+            edge_reader.next(point_edges, count);
+            pass.push(Label(((word & 1u) != 0 ? -1 : 1) * segment_label[word >> 1]), point_edges, count, write);
+          }
+          done += chunk.size();
+          report(Streaming_stage::REFINE, done, total);
+        }
+      }
+      pass.finish(write);
+      out->flush();
+      const streaming::internal::Relabelling_report& pr = pass.report();
+      if (pr.points != n)
+        throw std::runtime_error("streaming_orient_normals: the edge file and the record file disagree");
+      result.refinement_moves += pr.moves;
+      double change = 0.0;
+      segment_label = streaming::internal::solve_segment_graph(resegmenter, solver, change);
+      if (change < 0.0)
+        ++result.refinement_rounds_accepted;
+      result.energy_after_refinement = resegmenter.point_energy(segment_label);
+      in = std::move(out);
+    }
+    final_labels = std::move(in);
+    final_segment_label = std::move(segment_label);
+    report(Streaming_stage::REFINE, total, total);
+    result.seconds.refine = since(t);
+  }
+  edges.reset(); // removes the edge file
+
   // 6. Outward sign per component (the rule of Outward_component_sign, in
   //    two passes over the record file: extents, then votes).
   t = Clock::now();
@@ -737,28 +870,51 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   std::vector<std::array<double, 3>> sum_p(nc, {0, 0, 0}), sum_n(nc, {0, 0, 0});
   std::vector<double> sum_pn(nc, 0.0);
   std::vector<internal::Swept_record> buffer;
-  auto oriented = [&](const internal::Swept_record& s) {
+  std::vector<Label> labels; // the label of every point of `buffer`, before the sign of its component
+  std::vector<std::uint32_t> label_words;
+  auto rewind_points = [&]() {
+    records.rewind();
+    if (final_labels)
+      final_labels->rewind();
+  };
+  // reads the next points into `buffer` and their labels into `labels`;
+  // returns how many (0 at the end)
+  auto read_points = [&]() -> std::size_t {
+    buffer.clear();
+    const std::size_t got = records.read(buffer, 1 << 15);
+    labels.resize(got);
+    if (final_labels) {
+      label_words.clear();
+      if (got > 0 && final_labels->read(label_words, got) != got)
+        throw std::runtime_error("streaming_orient_normals: the label file is shorter than the record file");
+      for (std::size_t q = 0; q < got; ++q)
+        labels[q] = Label(((label_words[q] & 1u) != 0 ? -1 : 1) * final_segment_label[label_words[q] >> 1]);
+    } else {
+      for (std::size_t q = 0; q < got; ++q)
+        labels[q] = Label(buffer[q].flip * x[buffer[q].segment]);
+    }
+    return got;
+  };
+  auto oriented = [&](const internal::Swept_record& s, Label label) {
     std::array<double, 3> u = internal::unit_normal(s.record);
-    const double f = double(s.flip) * double(x[s.segment]);
+    const double f = double(label);
     return std::array<double, 3>{f * u[0], f * u[1], f * u[2]};
   };
   const int sign_passes = any_large ? 2 : 1;
   report(Streaming_stage::SIGN, 0, std::uint64_t(sign_passes) * n);
   for (int pass = 0; pass < sign_passes; ++pass) {
     std::fill(seen.begin(), seen.end(), 0);
-    records.rewind();
+    rewind_points();
     std::uint64_t read = 0;
-    while (true) {
-      buffer.clear();
-      if (records.read(buffer, 1 << 15) == 0)
-        break;
+    while (read_points() > 0) {
       read += buffer.size();
-      for (const internal::Swept_record& s : buffer) {
+      for (std::size_t q = 0; q < buffer.size(); ++q) {
+        const internal::Swept_record& s = buffer[q];
         const std::uint32_t c = component[s.segment];
         const double* p = s.record.position;
         if (size[c] < rule.minimum_size_for_directions) {
           if (pass == 0) {
-            const std::array<double, 3> on = oriented(s);
+            const std::array<double, 3> on = oriented(s, labels[q]);
             for (int d = 0; d < 3; ++d) {
               sum_p[c][d] += p[d];
               sum_n[c][d] += on[d];
@@ -769,7 +925,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
         }
         if (seen[c]++ % stride[c] != 0)
           continue;
-        const std::array<double, 3> on = oriented(s);
+        const std::array<double, 3> on = oriented(s, labels[q]);
         for (unsigned d = 0; d < D; ++d) {
           const double proj = p[0] * dir[d][0] + p[1] * dir[d][1] + p[2] * dir[d][2];
           const std::size_t slot = std::size_t(c) * D + d;
@@ -831,9 +987,9 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     kept = order.size();
   }
   // the final record of a swept point; true when its normal was turned
-  auto finish = [&](const internal::Swept_record& s, streaming::Point_record& out) {
+  auto finish = [&](const internal::Swept_record& s, Label point_label, streaming::Point_record& out) {
     out = s.record;
-    const int label = s.flip * int(x[s.segment]) * (flip_component[component[s.segment]] ? -1 : 1);
+    const int label = int(point_label) * (flip_component[component[s.segment]] ? -1 : 1);
     if (label >= 0)
       return false;
     for (double& v : out.normal)
@@ -844,19 +1000,17 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   // 7. Output.
   t = Clock::now();
   report(Streaming_stage::OUTPUT, 0, n);
-  records.rewind();
+  rewind_points();
   {
     std::uint64_t read = 0;
     streaming::Point_record out;
-    while (true) {
-      buffer.clear();
-      if (records.read(buffer, 1 << 15) == 0)
-        break;
+    while (read_points() > 0) {
       read += buffer.size();
-      for (const internal::Swept_record& s : buffer) {
+      for (std::size_t q = 0; q < buffer.size(); ++q) {
+        const internal::Swept_record& s = buffer[q];
         if (rank[component[s.segment]] == dropped)
           continue;
-        if (finish(s, out))
+        if (finish(s, labels[q], out))
           ++result.number_of_flipped;
         internal::hand_to_sink(sink, out, s.segment);
       }
@@ -893,17 +1047,15 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     streaming::Point_record out;
     if (groups == 1) {
       open_writers(0, kept);
-      records.rewind();
-      while (true) {
-        buffer.clear();
-        if (records.read(buffer, 1 << 15) == 0)
-          break;
+      rewind_points();
+      while (read_points() > 0) {
         done += buffer.size();
-        for (const internal::Swept_record& s : buffer) {
+        for (std::size_t q = 0; q < buffer.size(); ++q) {
+          const internal::Swept_record& s = buffer[q];
           const std::uint64_t r = rank[component[s.segment]];
           if (r == dropped)
             continue;
-          finish(s, out);
+          finish(s, labels[q], out);
           writers[std::size_t(r)].write(out);
         }
         report(Streaming_stage::COMPONENTS, done, total);
@@ -920,17 +1072,15 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
         for (std::size_t g = first_group; g < last_group; ++g)
           group_files.push_back(
             std::make_unique<streaming::Record_file<internal::Ranked_record>>(options.temporary_directory, 4096));
-        records.rewind();
-        while (true) {
-          buffer.clear();
-          if (records.read(buffer, 1 << 15) == 0)
-            break;
+        rewind_points();
+        while (read_points() > 0) {
           done += buffer.size();
-          for (const internal::Swept_record& s : buffer) {
+          for (std::size_t q = 0; q < buffer.size(); ++q) {
+            const internal::Swept_record& s = buffer[q];
             const std::uint64_t r = rank[component[s.segment]];
             if (r == dropped || r < first_rank || r >= last_rank)
               continue;
-            finish(s, out);
+            finish(s, labels[q], out);
             group_files[std::size_t(r / G) - first_group]->append(internal::Ranked_record{out, r});
           }
           report(Streaming_stage::COMPONENTS, done, total);

@@ -31,6 +31,8 @@ struct Segmentation_thresholds
   double contradiction = 0.0;
   /// theta_acc: the smallest |vote| of a segment that a point may join
   double acceptance = 0.5;
+  /// the most points a segment may hold (0: no limit)
+  std::size_t maximum_size = 0;
 };
 
 /// \ingroup PkgNormalOrientationStreaming
@@ -61,7 +63,8 @@ struct Segment_assignment
 namespace internal {
 
 /// An open-addressing hash map from a pair of segment numbers (a < b) to
-/// the sum of the weights between them, in insertion order.
+/// the sum of the weights between them and the sum of their absolute
+/// values, in insertion order.
 class Segment_pair_weights
 {
 public:
@@ -80,8 +83,9 @@ public:
     }
   }
 
-  /// adds `w` to the weight between `a` and `b`
-  void add(std::uint32_t a, std::uint32_t b, double w)
+  /// adds `w` to the weight between `a` and `b`, and `absolute` (the sum of
+  /// the absolute values of the weights `w` sums) to their absolute weight
+  void add(std::uint32_t a, std::uint32_t b, double w, double absolute)
   {
     const std::uint64_t key = make_key(a, b);
     for (std::size_t h = hash(key) & (m_slot.size() - 1);; h = (h + 1) & (m_slot.size() - 1)) {
@@ -90,12 +94,14 @@ public:
         m_slot[h] = std::uint32_t(m_key.size());
         m_key.push_back(key);
         m_weight.push_back(w);
+        m_absolute.push_back(absolute);
         if (2 * m_key.size() > m_slot.size())
           grow();
         return;
       }
       if (m_key[s] == key) {
         m_weight[s] += w;
+        m_absolute[s] += absolute;
         return;
       }
     }
@@ -109,6 +115,9 @@ public:
   std::uint32_t second(std::size_t i) const { return std::uint32_t(m_key[i]); }
   /// the weight of the `i`-th pair inserted
   double weight(std::size_t i) const { return m_weight[i]; }
+  /// the sum of the absolute values of the edge weights of the `i`-th pair
+  /// inserted (equal to |weight(i)| when they all have the same sign)
+  double absolute_weight(std::size_t i) const { return m_absolute[i]; }
 
 private:
   static constexpr std::uint32_t empty = ~std::uint32_t(0);
@@ -138,7 +147,7 @@ private:
 
   std::vector<std::uint32_t> m_slot;
   std::vector<std::uint64_t> m_key;
-  std::vector<double> m_weight;
+  std::vector<double> m_weight, m_absolute;
 };
 
 } // namespace internal
@@ -184,11 +193,24 @@ public:
   Segment_assignment add_point(const std::vector<Neighbor_vote>& votes, double preference = 0.0)
   {
     m_sums.clear();
-    for (const Neighbor_vote& v : votes) {
-      auto it = std::find_if(m_sums.begin(), m_sums.end(), [&](const Sum& x) { return x.segment == v.segment; });
-      if (it == m_sums.end())
-        it = m_sums.insert(m_sums.end(), Sum{v.segment, 0.0, 0.0});
-      (v.weight > 0.0 ? it->positive : it->negative) += v.weight;
+    bool one_segment = !votes.empty();
+    for (const Neighbor_vote& v : votes)
+      if (v.segment != votes.front().segment) {
+        one_segment = false;
+        break;
+      }
+    if (one_segment) { // the common case, summed in registers (the same sums)
+      double positive = 0.0, negative = 0.0;
+      for (const Neighbor_vote& v : votes)
+        (v.weight > 0.0 ? positive : negative) += v.weight;
+      m_sums.push_back(Sum{votes.front().segment, positive, negative});
+    } else {
+      for (const Neighbor_vote& v : votes) {
+        auto it = std::find_if(m_sums.begin(), m_sums.end(), [&](const Sum& x) { return x.segment == v.segment; });
+        if (it == m_sums.end())
+          it = m_sums.insert(m_sums.end(), Sum{v.segment, 0.0, 0.0});
+        (v.weight > 0.0 ? it->positive : it->negative) += v.weight;
+      }
     }
     std::size_t best = m_sums.size();
     double best_vote = m_theta.acceptance;
@@ -200,6 +222,8 @@ public:
       const double strength = f * vote;
       const double against = f > 0 ? -s.negative : s.positive;
       if (strength < best_vote || against > m_theta.contradiction || (best != m_sums.size() && strength == best_vote))
+        continue;
+      if (m_theta.maximum_size != 0 && m_size[s.segment] >= m_theta.maximum_size)
         continue;
       bool valid = true;
       for (const Sum& t : m_sums) {
@@ -222,13 +246,17 @@ public:
     if (best == m_sums.size()) {
       result = Segment_assignment{std::uint32_t(m_preference.size()), Label(1), true};
       m_preference.push_back(0.0);
+      m_size.push_back(0);
     } else {
       result = Segment_assignment{m_sums[best].segment, best_flip, false};
     }
     for (const Sum& t : m_sums)
       if (t.segment != result.segment)
-        m_between.add(result.segment, t.segment, result.flip * (t.positive + t.negative));
+        m_between.add(result.segment, t.segment, result.flip * (t.positive + t.negative), t.positive - t.negative);
+      else // the edges inside the segment that contradict the flip
+        m_inside += result.flip > 0 ? -t.negative : t.positive;
     m_preference[result.segment] += result.flip * preference;
+    ++m_size[result.segment];
     ++m_points;
     return result;
   }
@@ -243,6 +271,23 @@ public:
   /// the summed unary preference of each segment, in the frame of its
   /// preliminary orientation
   const std::vector<double>& segment_preferences() const { return m_preference; }
+  /// the energy of the edges inside the segments (in the preliminary
+  /// orientation; the same for every labelling that keeps the segments rigid)
+  double energy_inside_segments() const { return m_inside; }
+  /// The energy of the edges seen so far (the votes; `edge_energy()`
+  /// summed over them) for the labelling that gives the points of each
+  /// segment s their preliminary orientation times `x[s]`: the energy
+  /// inside the segments plus, per segment pair (a, b) of weight W and
+  /// absolute weight A, (A - W x_a x_b) / 2.  It is exactly 0 when no
+  /// edge contradicts that labelling.
+  /// \pre `x` has a label per segment
+  double point_energy(const std::vector<Label>& x) const
+  {
+    double e = m_inside;
+    for (std::size_t i = 0; i < m_between.size(); ++i)
+      e += 0.5 * (m_between.absolute_weight(i) - m_between.weight(i) * x[m_between.first(i)] * x[m_between.second(i)]);
+    return e;
+  }
 
 private:
   struct Sum
@@ -255,8 +300,10 @@ private:
   bool m_may_flip;
   internal::Segment_pair_weights m_between;
   std::vector<double> m_preference;
+  std::vector<std::size_t> m_size;
   std::vector<Sum> m_sums;
   std::size_t m_points = 0;
+  double m_inside = 0.0;
 };
 
 } // namespace streaming
