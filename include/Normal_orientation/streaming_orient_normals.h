@@ -741,17 +741,8 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   report(Streaming_stage::SOLVE, 0, 1);
   const std::size_t ns = segmenter.number_of_segments();
   result.number_of_segments = ns;
-  const auto& pairs = segmenter.segment_pairs();
-  std::vector<std::uint32_t> sources, targets;
-  std::vector<Neighbor_edge> props;
-  for (std::size_t e = 0; e < pairs.size(); ++e)
-    if (pairs.weight(e) != 0.0) {
-      sources.push_back(pairs.first(e));
-      targets.push_back(pairs.second(e));
-      props.push_back(Neighbor_edge{float(pairs.weight(e))});
-    }
-  result.number_of_segment_edges = sources.size();
-  Neighbor_graph sg(boost::construct_inplace_from_sources_and_targets, sources, targets, props, std::uint32_t(ns));
+  const Neighbor_graph sg = streaming::internal::make_segment_graph(segmenter);
+  result.number_of_segment_edges = num_edges(sg);
   const auto weight = get(&Neighbor_edge::weight, sg);
   std::vector<Label> x(ns, Label(1));
   result.segment_energy_before = energy(sg, weight, CGAL::make_property_map(x));

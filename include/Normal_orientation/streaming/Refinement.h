@@ -419,6 +419,24 @@ inline std::vector<Label> improve_segment_labelling(const Segmenter& segmenter)
   return x;
 }
 
+/// The segment graph accumulated by `segmenter` as a `Neighbor_graph`: a
+/// vertex per segment, an edge per pair of segments of nonzero summed
+/// weight, with that weight (single precision, as in the point graph).
+inline Neighbor_graph make_segment_graph(const Segmenter& segmenter)
+{
+  const Segment_pair_weights& pairs = segmenter.segment_pairs();
+  std::vector<std::uint32_t> sources, targets;
+  std::vector<Neighbor_edge> props;
+  for (std::size_t t = 0; t < pairs.size(); ++t)
+    if (pairs.weight(t) != 0.0) {
+      sources.push_back(pairs.first(t));
+      targets.push_back(pairs.second(t));
+      props.push_back(Neighbor_edge{float(pairs.weight(t))});
+    }
+  return Neighbor_graph(boost::construct_inplace_from_sources_and_targets, sources, targets, props,
+                        std::uint32_t(segmenter.number_of_segments()));
+}
+
 /// The labelling of the segment graph of `segmenter` of lowest energy among
 /// all +1 (the current labelling), that of `improve_segment_labelling()`
 /// (which finds the improvements near the current labelling) and that of
@@ -437,19 +455,9 @@ std::vector<Label> solve_segment_graph(const Segmenter& segmenter, const Solver&
     change = c;
     best.swap(x);
   }
-  const Segment_pair_weights& pairs = segmenter.segment_pairs();
-  std::vector<std::uint32_t> sources, targets;
-  std::vector<Neighbor_edge> props;
-  for (std::size_t t = 0; t < pairs.size(); ++t)
-    if (pairs.weight(t) != 0.0) {
-      sources.push_back(pairs.first(t));
-      targets.push_back(pairs.second(t));
-      props.push_back(Neighbor_edge{float(pairs.weight(t))});
-    }
-  if (sources.empty())
+  const Neighbor_graph g = make_segment_graph(segmenter);
+  if (num_edges(g) == 0)
     return best;
-  const Neighbor_graph g(boost::construct_inplace_from_sources_and_targets, sources, targets, props,
-                         std::uint32_t(ns));
   x.assign(ns, Label(1));
   solver.solve(g, get(&Neighbor_edge::weight, g), CGAL::make_property_map(x));
   c = segment_energy_change(segmenter, x);
