@@ -109,6 +109,7 @@ struct Options
   unsigned long long min_component_size = 0;
   bool min_component_size_given = false;
   bool write_segments = false; // --stream: the segment of each point in OUT (PLY)
+  bool keep_order = false;     // --stream: OUT is IN in its own order and format
   unsigned long long batch_size = 0; // --stream: 0 = the library's default
   long refine_rounds = -1;            // --stream: -1 = the library's default
 };
@@ -158,6 +159,10 @@ const char* usage_text =
   "                       report: dropped_points, dropped_components; default 0)\n"
   "  --write-segments     with --stream and a .ply OUT: add to each point its segment\n"
   "                       (vertex property 'int segment', 0 to segments - 1)\n"
+  "  --keep-order         with --stream: write OUT as a copy of IN in its own order and\n"
+  "                       format (OUT .ply for a .ply IN, .xyz/.pwn for .xyz/.pwn),\n"
+  "                       with every other property kept and only the signs of the\n"
+  "                       normals changed (one more reading of IN)\n"
   "  --batch-size N       with --stream: points whose neighbours are searched at\n"
   "                       once (one kd-tree each; default 262144): larger is\n"
   "                       faster and holds more points (the peak window grows by\n"
@@ -278,6 +283,8 @@ Options parse_options(int argc, char** argv)
       o.min_component_size_given = true;
     } else if (a == "--write-segments") {
       o.write_segments = true;
+    } else if (a == "--keep-order") {
+      o.keep_order = true;
     } else if (a == "--batch-size") {
       const long long b = parse_number<long long>(a, value());
       if (b < 1 || b > (1ll << 30))
@@ -312,6 +319,12 @@ Options parse_options(int argc, char** argv)
     throw Usage_error("--write-segments needs --stream");
   if (!o.stream && o.refine_rounds >= 0)
     throw Usage_error("--refine needs --stream");
+  if (!o.stream && o.keep_order)
+    throw Usage_error("--keep-order needs --stream");
+  if (o.keep_order && o.write_segments)
+    throw Usage_error("--keep-order copies IN: --write-segments is not supported with it");
+  if (o.keep_order && o.ascii)
+    throw Usage_error("--keep-order writes OUT in the format of IN: --ascii is not supported with it");
   if (positional.empty()) {
     o.input = NORMAL_ORIENTATION_SAMPLE_CLOUD;
     o.output = "sample_oriented.ply";
@@ -329,6 +342,10 @@ Options parse_options(int argc, char** argv)
   }
   if (o.write_segments && NO::IO::internal::lower_case_extension(o.output) != ".ply")
     throw Usage_error("--write-segments needs a .ply OUT");
+  if (o.keep_order && (NO::IO::internal::lower_case_extension(o.input) == ".ply") !=
+                        (NO::IO::internal::lower_case_extension(o.output) == ".ply"))
+    throw Usage_error("--keep-order writes OUT in the format of IN: OUT must be a .ply file for a .ply IN, "
+                      "a .xyz or .pwn file for a .xyz or .pwn IN");
   return o;
 }
 
@@ -496,12 +513,17 @@ int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
   wo.binary = !o.ascii;
   wo.segments = o.write_segments;
   NO::Streaming_result r;
+  auto run = [&](const auto& criterion, const auto& solver) {
+    if (o.keep_order)
+      return NO::streaming_orient_files_in_input_order(o.input, o.output, so, criterion, solver);
+    return NO::streaming_orient_files(o.input, o.output, so, criterion, solver, wo);
+  };
   auto with_solver = [&](const auto& criterion) {
     if (o.solver == "mst")
-      return NO::streaming_orient_files(o.input, o.output, so, criterion, NO::Mst_solver(), wo);
+      return run(criterion, NO::Mst_solver());
     if (o.solver == "lsa-tr")
-      return NO::streaming_orient_files(o.input, o.output, so, criterion, NO::Lsa_tr_solver(), wo);
-    return NO::streaming_orient_files(o.input, o.output, so, criterion, NO::Qpbo_i_solver(o.orders, o.seed), wo);
+      return run(criterion, NO::Lsa_tr_solver());
+    return run(criterion, NO::Qpbo_i_solver(o.orders, o.seed));
   };
   NO::internal::run_with_threads(o.threads, [&]() {
     if (o.criterion == "xie")
@@ -538,7 +560,7 @@ int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
     std::printf("{\"input\": \"%s\", \"output\": \"%s\", \"mode\": \"stream\", \"points\": %llu, \"edges\": %llu, "
                 "\"segments\": %zu, \"segment_edges\": %zu, \"components\": %zu, \"dropped_components\": %zu, "
                 "\"dropped_points\": %llu, \"min_component_size\": %llu, \"component_files\": %zu, "
-                "\"components_dir\": %s, \"presorted\": %s, \"peak_window\": %zu, \"k\": %u, "
+                "\"components_dir\": %s, \"presorted\": %s, \"keep_order\": %s, \"peak_window\": %zu, \"k\": %u, "
                 "\"radius\": %.9g, \"radius_estimated\": %s, \"criterion\": \"%s\", \"solver\": \"%s\", "
                 "\"threads\": %d, \"segment_energy_before\": %.9g, \"segment_energy_after\": %.9g, "
                 "\"refinement_rounds\": %u, \"refinement_rounds_accepted\": %u, \"refinement_moves\": %llu, "
@@ -551,7 +573,7 @@ int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
                 r.number_of_components, r.number_of_dropped_components,
                 (unsigned long long)r.number_of_dropped_points, o.min_component_size, r.component_files.size(),
                 o.components_dir.empty() ? "null" : ("\"" + json_escape(o.components_dir) + "\"").c_str(),
-                o.presorted.empty() ? "null" : ("\"" + o.presorted + "\"").c_str(), r.peak_window, o.k,
+                o.presorted.empty() ? "null" : ("\"" + o.presorted + "\"").c_str(), o.keep_order ? "true" : "false", r.peak_window, o.k,
                 r.neighbor_radius, r.radius_estimated ? "true" : "false",
                 o.criterion.c_str(), o.solver.c_str(), o.threads, r.segment_energy_before, r.segment_energy_after,
                 so.refinement.rounds, r.refinement_rounds_accepted, (unsigned long long)r.refinement_moves,

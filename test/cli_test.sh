@@ -295,13 +295,29 @@ awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/bare.xyz"
 expect_exit 0 "estimates missing normals" "$prog" --quiet --normals pca "$dir/bare.xyz" "$dir/bare_out.xyz"
 check "estimated normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/bare_out.xyz"
 
+# --keep-order: OUT is IN itself, in its order and with its text, only the
+# signs of the normals changed, and the same signs as the sweep-order output
+expect_exit 0 "stream --keep-order" "$prog" --quiet --json --stream --keep-order "$dir/sphere.xyz" "$dir/kept.xyz"
+check "json says keep_order" grep -q '"keep_order": true' "$dir/out.txt"
+check "--keep-order: the input's lines, the normals outward" awk 'NR==FNR { l[FNR] = $1 " " $2 " " $3; n++; next }
+  { if ($1 " " $2 " " $3 != l[FNR] || $1*$4 + $2*$5 + $3*$6 <= 0) bad++; c++ } END { exit (bad > 0 || c != n) }' \
+  "$dir/sphere.xyz" "$dir/kept.xyz"
+check "--keep-order: the same normals as the sweep order" awk '
+  NR==FNR { v[sprintf("%.7f %.7f %.7f", $1, $2, $3)] = sprintf("%.7f %.7f %.7f", $4, $5, $6); n++; next }
+  { k = sprintf("%.7f %.7f %.7f", $1, $2, $3); if (!(k in v) || v[k] != sprintf("%.7f %.7f %.7f", $4, $5, $6)) bad++; c++ }
+  END { exit (bad > 0 || c != n) }' "$dir/stream.xyz" "$dir/kept.xyz"
+expect_exit 2 "--keep-order into another format" "$prog" --quiet --stream --keep-order "$dir/sphere.xyz" "$dir/kept.ply"
+check "no output for --keep-order into another format" test ! -e "$dir/kept.ply"
+
 # bad options: exit 2, one line on stderr, no output (the options of --stream
 # need it)
 for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads -1" "--threads x" \
     "--threads 1025" "--threads" "--bogus" "--viewpoint 1,2" "--prior-weight 1" "--viewpoint 0,0,0 --prior-weight -1" "--viewpoint 0,0,0 --prior-weight nan" \
     "--presorted x" "--stream --presorted w" "--stream --presorted" "--components-dir $dir/cd" "--min-component-size 5" \
     "--stream --min-component-size -1" "--stream --min-component-size x" "--write-segments" \
-    "--stream --write-segments" "--batch-size 10" "--stream --batch-size 0" "--stream --batch-size x"; do
+    "--stream --write-segments" "--batch-size 10" "--stream --batch-size 0" "--stream --batch-size x" \
+    "--keep-order" "--stream --keep-order --ascii" "--stream --keep-order --write-segments" "--refine 1" \
+    "--stream --refine 17" "--stream --refine x"; do
   # shellcheck disable=SC2086
   expect_exit 2 "bad option $args" "$prog" $args "$dir/sphere.xyz" "$dir/bad_opt.xyz"
   check "one-line error for $args" test "$(wc -l < "$dir/err.txt")" -eq 1

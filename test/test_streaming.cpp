@@ -996,6 +996,112 @@ TEST(Streaming_components, MinimumSizeDropsSmallComponentsFromEveryOutput)
   EXPECT_EQ(source.delivered(), 0u);
 }
 
+// streaming_orient_files_in_input_order: OUT is IN in its own order and
+// format, every other property kept, only the signs of the normals changed
+// (those of streaming_orient_files, point for point), the dropped components
+// left out; a format other than IN's is refused before any work; nothing is
+// left behind.
+TEST(Streaming_components, InputOrderCopyKeepsEveryPropertyAndTheOrder)
+{
+  Temporary_directory directory, files;
+  std::mt19937_64 rng(23);
+  const Test_cloud cloud = two_bodies_and_dust(rng);
+  const std::size_t n = cloud.records.size();
+  // an ascii PLY with float normals between the coordinates and a colour after them
+  {
+    std::ofstream out(files.file("in.ply"), std::ios::binary);
+    out << "ply\nformat ascii 1.0\ncomment kept as it is\nelement vertex " << n
+        << "\nproperty float nx\nproperty double x\nproperty double y\nproperty double z\nproperty float ny\n"
+           "property float nz\nproperty uchar red\nend_header\n";
+    out.precision(17);
+    for (const Point_record& r : cloud.records)
+      out << float(r.normal[0]) << ' ' << r.position[0] << ' ' << r.position[1] << ' ' << r.position[2] << ' '
+          << float(r.normal[1]) << ' ' << float(r.normal[2]) << ' ' << (r.index * 7) % 256 << '\n';
+  }
+  write_cloud(files.file("in.xyz"), read_cloud(files.file("in.ply")));
+  NO::Streaming_options options = streaming_options_in(directory.path());
+  options.radius = 0.3;
+  options.minimum_component_size = 10;
+  const NO::Streaming_result reference =
+    NO::streaming_orient_files(files.file("in.ply"), files.file("sweep.ply"), options);
+  const std::vector<Point_record> swept = read_cloud(files.file("sweep.ply"));
+  ASSERT_EQ(swept.size(), n - 6);
+
+  NO::IO::Transcode_report report;
+  const NO::Streaming_result r = NO::streaming_orient_files_in_input_order<CGAL::Parallel_if_available_tag>(
+    files.file("in.ply"), files.file("out.ply"), options, NO::Hoppe_criterion(), NO::Qpbo_i_solver(), &report);
+  EXPECT_EQ(r.number_of_points, n);
+  EXPECT_EQ(r.number_of_dropped_points, 6u);
+  EXPECT_EQ(r.number_of_flipped, reference.number_of_flipped);
+  EXPECT_EQ(report.number_of_points, n);
+  EXPECT_EQ(report.number_of_written_points, n - 6);
+  EXPECT_EQ(report.number_of_flipped, r.number_of_flipped);
+  EXPECT_GT(r.number_of_flipped, 0u);
+  // the input's order, without the dust (the 6 points beyond x = 19)
+  const std::vector<Point_record> input = read_cloud(files.file("in.ply")), out = read_cloud(files.file("out.ply"));
+  std::vector<Point_record> kept;
+  for (const Point_record& p : input)
+    if (p.position[0] < 19.)
+      kept.push_back(p); // with its index in the input
+  ASSERT_EQ(out.size(), kept.size());
+  for (std::size_t i = 0; i < out.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_EQ(out[i].position[c], kept[i].position[c]) << i;
+      ASSERT_EQ(std::abs(out[i].normal[c]), std::abs(kept[i].normal[c])) << i;
+    }
+  // the same normals as the sweep-order output, point for point
+  EXPECT_EQ(sorted_points(out), sorted_points(swept));
+  std::vector<Point_record> indexed = out; // with the indices of `cloud` (shuffled in the file)
+  for (std::size_t i = 0; i < out.size(); ++i)
+    indexed[i].index = cloud.records[std::size_t(kept[i].index)].index;
+  EXPECT_EQ(cloud.wrong(indexed), 0u);
+  // the header (comment, property order and types) and the colours as they were
+  std::ifstream in_text(files.file("in.ply")), out_text(files.file("out.ply"));
+  std::string a, b;
+  std::size_t line = 0, data = 0;
+  while (std::getline(out_text, b)) {
+    do
+      std::getline(in_text, a);
+    while (line >= 12 && std::stod(a.substr(a.find(' ') + 1)) >= 19.); // a dropped point
+    if (line == 3)
+      EXPECT_EQ(b, "element vertex " + std::to_string(n - 6));
+    else if (line < 12) // the header: 7 properties
+      EXPECT_EQ(b, a);
+    else {
+      EXPECT_EQ(b.substr(b.rfind(' ')), a.substr(a.rfind(' '))) << line; // red
+      ++data;
+    }
+    ++line;
+  }
+  EXPECT_EQ(data, n - 6);
+
+  // an .xyz input: an .xyz copy, with the same signs
+  const NO::Streaming_result rx =
+    NO::streaming_orient_files_in_input_order(files.file("in.xyz"), files.file("out.xyz"), options);
+  EXPECT_EQ(rx.number_of_flipped, r.number_of_flipped);
+  EXPECT_EQ(sorted_points(read_cloud(files.file("out.xyz"))), sorted_points(out));
+  // another format than the input's: refused before any work, nothing written
+  EXPECT_THROW(NO::streaming_orient_files_in_input_order(files.file("in.ply"), files.file("out2.xyz"), options),
+               NO::IO::Io_error);
+  EXPECT_THROW(NO::streaming_orient_files_in_input_order(files.file("in.xyz"), files.file("out2.ply"), options),
+               NO::IO::Io_error);
+  EXPECT_FALSE(fs::exists(files.file("out2.xyz")));
+  EXPECT_FALSE(fs::exists(files.file("out2.ply")));
+  // a cancellation during the copy: no output, nothing left
+  NO::Streaming_options cancel = options;
+  cancel.callback = [n](const NO::Streaming_progress& p) { // the copy counts bytes, not points
+    return !(p.stage == NO::Streaming_stage::OUTPUT && p.total != n && p.done > 0);
+  };
+  EXPECT_THROW(NO::streaming_orient_files_in_input_order(files.file("in.ply"), files.file("out3.ply"), cancel),
+               NO::Interrupted);
+  EXPECT_FALSE(fs::exists(files.file("out3.ply")));
+  EXPECT_EQ(directory.count(), 0u);
+  std::size_t in_files = 0;
+  for (const auto& e : fs::directory_iterator(files.path()))
+    in_files += e.path().filename().string().find(".tmp.") != std::string::npos ? 1 : 0;
+  EXPECT_EQ(in_files, 0u);
+}
+
 TEST(Streaming_components, ManyComponentsWithFewOpenFiles)
 {
   Temporary_directory directory, parts;

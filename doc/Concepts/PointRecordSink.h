@@ -18,7 +18,10 @@ A sink that can also be called with a second argument, `std::uint32_t segment`, 
 so: it then gets the segment of the point too (the segments of the streaming segmentation,
 numbered from 0 to `Normal_orientation::Streaming_result::number_of_segments` - 1), which is
 how `Normal_orientation::streaming_orient_files()` writes them with
-`Normal_orientation::IO::Point_stream_write_options::segments`.
+`Normal_orientation::IO::Point_stream_write_options::segments`.  A sink that can be called
+with a third argument, `bool flipped`, is called so: it then also learns whether the normal of
+the point was negated, which is how `Normal_orientation::streaming_orient_files_in_input_order()`
+notes the flips by input index without keeping the points.
 
 \cgalHasModelsBegin
 \cgalHasModels{Normal_orientation::streaming::Normal_writer}
@@ -35,4 +38,7 @@ public:
   /// optional: receives one oriented point and its segment (called instead of the
   /// operator above when the sink has it)
   void operator()(const Normal_orientation::streaming::Point_record& record, std::uint32_t segment);
+  /// optional: receives one oriented point, its segment and whether its normal was negated
+  /// (called instead of the operators above when the sink has it)
+  void operator()(const Normal_orientation::streaming::Point_record& record, std::uint32_t segment, bool flipped);
 };

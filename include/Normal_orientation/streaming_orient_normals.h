@@ -15,6 +15,7 @@
 #include <Normal_orientation/Flip_criteria.h>
 #include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/IO/Point_stream.h>
+#include <Normal_orientation/IO/Point_stream_transcode.h>
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/internal/Progress.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
@@ -296,12 +297,14 @@ inline std::array<double, 3> unit_normal(const streaming::Point_record& r)
   return {r.normal[0] * inv, r.normal[1] * inv, r.normal[2] * inv};
 }
 
-/// Hands `record` to `sink`, with the segment of the point when the sink
-/// takes it (see `PointRecordSink`).
+/// Hands `record` to `sink`, with the segment of the point and whether its
+/// normal was negated when the sink takes them (see `PointRecordSink`).
 template <typename Sink>
-void hand_to_sink(Sink& sink, const streaming::Point_record& record, std::uint32_t segment)
+void hand_to_sink(Sink& sink, const streaming::Point_record& record, std::uint32_t segment, bool flipped)
 {
-  if constexpr (std::is_invocable_v<Sink&, const streaming::Point_record&, std::uint32_t>)
+  if constexpr (std::is_invocable_v<Sink&, const streaming::Point_record&, std::uint32_t, bool>)
+    sink(record, segment, flipped);
+  else if constexpr (std::is_invocable_v<Sink&, const streaming::Point_record&, std::uint32_t>)
     sink(record, segment);
   else
     sink(record);
@@ -1001,9 +1004,10 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
         const internal::Swept_record& s = buffer[q];
         if (rank[component[s.segment]] == dropped)
           continue;
-        if (finish(s, labels[q], out))
+        const bool flipped = finish(s, labels[q], out);
+        if (flipped)
           ++result.number_of_flipped;
-        internal::hand_to_sink(sink, out, s.segment);
+        internal::hand_to_sink(sink, out, s.segment, flipped);
       }
       report(Streaming_stage::OUTPUT, read, n);
     }
@@ -1172,6 +1176,104 @@ Streaming_result streaming_orient_files(const std::string& input, const std::str
     throw;
   }
   result.seconds.output += std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  return result;
+}
+
+/// \ingroup PkgNormalOrientationStreaming
+/// Orients the cloud of the file `input` out of core, as
+/// `streaming_orient_files()` does, and writes `output` as a copy of
+/// `input` in its own order and format, in which only the signs of the
+/// normals differ (see `IO::transcode_with_flips()`): every other vertex
+/// property, the text of every value not negated, the header's comments
+/// and the type of every property are kept; the components smaller than
+/// `Streaming_options::minimum_component_size` are left out (their points
+/// removed, the vertex count of a PLY header updated); as with
+/// `IO::write_point_cloud()`, the PLY elements other than `vertex` are left
+/// out.  The stream hands the oriented points to a sink that notes, by
+/// input index, which normals to negate and which points to keep (2 bits
+/// per point in memory, 25 MB for 100M points); then the input is copied
+/// with those changes, in one more reading of the file, with fixed memory.
+/// The output is written to a temporary file renamed at the end: on any
+/// error or interruption no output file exists (an existing one is left
+/// unchanged).  `Streaming_options::component_files` works as in
+/// `streaming_orient_files()` (files in the sweep order, in the format of
+/// `output`).  The copy is reported to `Streaming_options::callback` as the
+/// stage `OUTPUT`, in bytes of the input.
+/// \throw IO::Io_error for unreadable, malformed or unwritable files, an
+///        input without normals or without any point, an `output` whose
+///        format differs from `input`'s (checked before any work), normals
+///        of an unsigned integer type that must be negated, an input that
+///        changes while it is read; see `streaming_orient_files()`
+/// \tparam ConcurrencyTag, Kernel, FlipCriterion, Solver as for `streaming_orient_normals()`
+/// \param input the file to orient (.xyz/.pwn with normals, or .ply with normals)
+/// \param output the file written, in the format of `input` (.ply for a .ply
+///        input; .xyz or .pwn for a .xyz or .pwn input)
+/// \param options, criterion, solver as for `streaming_orient_normals()`
+/// \param transcode when not null, receives the figures of the copy
+/// \return the figures of the run (`seconds.output` includes the copy)
+template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag,
+          typename Kernel = CGAL::Exact_predicates_inexact_constructions_kernel,
+          typename FlipCriterion = Hoppe_criterion, typename Solver = Qpbo_i_solver>
+Streaming_result streaming_orient_files_in_input_order(const std::string& input, const std::string& output,
+                                                       const Streaming_options& options = Streaming_options(),
+                                                       const FlipCriterion& criterion = FlipCriterion(),
+                                                       const Solver& solver = Solver(),
+                                                       IO::Transcode_report* transcode = nullptr)
+{
+  IO::Point_stream_reader reader(input);
+  if (!reader.has_normals())
+    throw IO::Io_error(input + ": the file has no normals (streaming needs them)");
+  const std::string in_ext = IO::internal::lower_case_extension(input);
+  const std::string out_ext = IO::internal::lower_case_extension(output);
+  if (out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".pwn")
+    throw IO::Io_error(output + ": unknown point cloud file extension '" + out_ext + "' (expected .xyz, .pwn or .ply)");
+  if ((in_ext == ".ply") != (out_ext == ".ply"))
+    throw IO::Io_error(output + ": the copy of '" + input + "' in its own order must be a " +
+                       (in_ext == ".ply" ? std::string(".ply") : std::string(".xyz or .pwn")) + " file, as the input");
+  Streaming_options o = options;
+  if (!o.component_files.directory.empty() && o.component_files.extension.empty())
+    o.component_files.extension = std::filesystem::path(output).extension().string();
+  IO::Bit_set flip, keep;
+  // the number of points is known (from the first pass) when the output stage starts
+  o.callback = [&](const Streaming_progress& p) {
+    if (p.stage == Streaming_stage::OUTPUT && p.done == 0 && keep.size() != p.total) {
+      flip = IO::Bit_set(p.total);
+      keep = IO::Bit_set(p.total);
+    }
+    return options.callback ? options.callback(p) : true;
+  };
+  auto sink = [&](const streaming::Point_record& r, std::uint32_t, bool flipped) {
+    keep.set(r.index); // throws std::out_of_range on an index beyond the count
+    if (flipped)
+      flip.set(r.index);
+  };
+  Streaming_result result = streaming_orient_normals<ConcurrencyTag, Kernel>(reader, sink, o, criterion, solver);
+  try {
+    if (result.number_of_points == 0) // as in core: an empty cloud is an error, not an empty output
+      throw IO::Io_error(input + ": the file holds no point");
+    const auto t = std::chrono::steady_clock::now();
+    IO::Transcode_options to;
+    if (options.callback)
+      to.callback = [&options](std::uint64_t done, std::uint64_t size) {
+        Streaming_progress p;
+        p.stage = Streaming_stage::OUTPUT;
+        p.done = done;
+        p.total = size;
+        return options.callback(p);
+      };
+    const IO::Transcode_report tr =
+      IO::transcode_with_flips(input, output, flip, result.number_of_dropped_points > 0 ? &keep : nullptr, to);
+    if (transcode != nullptr)
+      *transcode = tr;
+    const double copy = std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+    result.seconds.output += copy;
+    result.seconds.total += copy;
+  } catch (...) {
+    std::error_code ec;
+    for (const std::string& f : result.component_files)
+      std::filesystem::remove(f, ec);
+    throw;
+  }
   return result;
 }
 
