@@ -11,7 +11,7 @@
 #include "Reference_mesh.h"
 
 #include <Normal_orientation/IO/Point_stream.h>
-#include <Normal_orientation/streaming/Point_record.h>
+#include <Normal_orientation/Point_record.h>
 
 #ifdef CGAL_LINKED_WITH_TBB
 #include <tbb/blocked_range.h>
@@ -73,14 +73,14 @@ struct Counts
 };
 
 /// Evaluates `records[begin, end)` against the mesh.
-Counts evaluate(const Reference_normals& reference, const std::vector<NO::streaming::Point_record>& records,
+Counts evaluate(const Reference_normals& reference, const std::vector<NO::Point_record>& records,
                 std::size_t begin, std::size_t end, double far_squared)
 {
   Counts counts;
   Candidates candidates;
   for(std::size_t i = begin; i < end; ++i)
   {
-    const NO::streaming::Point_record& r = records[i];
+    const NO::Point_record& r = records[i];
     const Point_3 p(r.position[0], r.position[1], r.position[2]);
     const std::pair<Vector_3, double> truth = reference.truth(p, candidates);
     if(Reference_normals::is_wrong(truth.first, r.normal))
@@ -178,7 +178,7 @@ int run(const Options& o)
   double read_seconds = 0.0;
   Counts total;
   std::uint64_t n = 0;
-  std::vector<NO::streaming::Point_record> chunk;
+  std::vector<NO::Point_record> chunk;
   chunk.reserve(chunk_size);
   for(;;)
   {

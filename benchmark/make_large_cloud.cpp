@@ -11,7 +11,7 @@
 #include "Mesh_sampler.h" // mix_seed, uniform_01, Gaussian_generator
 
 #include <Normal_orientation/IO/Point_stream.h>
-#include <Normal_orientation/streaming/Point_record.h>
+#include <Normal_orientation/Point_record.h>
 
 #include <CGAL/IO/polygon_soup_io.h>
 
@@ -157,7 +157,7 @@ public:
    * `angle_sigma` is 0, so positions and signs do not depend on the noise level.
    */
   void sample_block(std::uint64_t seed, std::uint64_t block, std::uint64_t first, double angle_sigma,
-                    NO::streaming::Point_record* out, std::size_t count) const
+                    NO::Point_record* out, std::size_t count) const
   {
     std::mt19937_64 rng(NB::mix_seed(NB::mix_seed(seed) + block));
     NB::Gaussian_generator gaussian(rng);
@@ -176,7 +176,7 @@ public:
       const double g2 = angle_sigma * gaussian();
       const bool flip = (rng() >> 63) != 0;
 
-      NO::streaming::Point_record& record = out[i];
+      NO::Point_record& record = out[i];
       for(int d = 0; d < 3; ++d)
         record.position[d] = a * tri.vertex[0][d] + b * tri.vertex[1][d] + c * tri.vertex[2][d];
       const double angle = std::sqrt(g1 * g1 + g2 * g2);
@@ -283,7 +283,7 @@ int run(const Options& o)
 
   const std::uint64_t n = o.number_of_points;
   const std::uint64_t number_of_blocks = (n + rng_block_size - 1) / rng_block_size;
-  std::vector<NO::streaming::Point_record> batch;
+  std::vector<NO::Point_record> batch;
   double write_seconds = 0.0;
   for(std::uint64_t first_block = 0; first_block < number_of_blocks; first_block += blocks_per_batch)
   {

@@ -58,7 +58,7 @@ int main(int argc, char** argv)
     }
     NO::IO::Point_stream_write_options write_options; // binary PLY, with normals
     NO::IO::Point_stream_writer writer(argv[2], write_options);
-    auto sink = [&writer](const NO::streaming::Point_record& record) { writer.write(record); };
+    auto sink = [&writer](const NO::Point_record& record) { writer.write(record); };
 
     const NO::Streaming_result r =
       NO::streaming_orient_normals(reader, sink, options, NO::Hoppe_criterion(), NO::Qpbo_i_solver());

@@ -39,7 +39,7 @@
 namespace {
 
 namespace IO = fuzz::IO;
-using Normal_orientation::streaming::Point_record;
+using Normal_orientation::Point_record;
 
 /// \brief Result of streaming a file.
 struct Streamed

@@ -1259,7 +1259,7 @@ namespace {
 using Normal_orientation::IO::Point_stream_reader;
 using Normal_orientation::IO::Point_stream_write_options;
 using Normal_orientation::IO::Point_stream_writer;
-using Normal_orientation::streaming::Point_record;
+using Normal_orientation::Point_record;
 
 /// \brief All the records of `reader`, read `chunk_size` at a time.
 std::vector<Point_record> read_stream(Point_stream_reader& reader, std::size_t chunk_size)

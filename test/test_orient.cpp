@@ -511,9 +511,9 @@ namespace {
 
 struct Vector_source
 {
-  const std::vector<NO::streaming::Point_record>* records;
+  const std::vector<NO::Point_record>* records;
   std::size_t next = 0;
-  std::size_t read(std::vector<NO::streaming::Point_record>& chunk, std::size_t maximum)
+  std::size_t read(std::vector<NO::Point_record>& chunk, std::size_t maximum)
   {
     const std::size_t m = std::min(maximum, records->size() - next);
     chunk.insert(chunk.end(), records->begin() + std::ptrdiff_t(next), records->begin() + std::ptrdiff_t(next + m));
@@ -546,11 +546,11 @@ struct Edge_collector
   }
 };
 
-std::vector<NO::streaming::Point_record> sorted_records(const std::vector<Sample>& s)
+std::vector<NO::Point_record> sorted_records(const std::vector<Sample>& s)
 {
-  std::vector<NO::streaming::Point_record> r(s.size());
+  std::vector<NO::Point_record> r(s.size());
   for (std::size_t i = 0; i < s.size(); ++i)
-    r[i] = NO::streaming::Point_record{{s[i].p.x(), s[i].p.y(), s[i].p.z()}, {s[i].n.x(), s[i].n.y(), s[i].n.z()}, i};
+    r[i] = NO::Point_record{{s[i].p.x(), s[i].p.y(), s[i].p.z()}, {s[i].n.x(), s[i].n.y(), s[i].n.z()}, i};
   std::sort(r.begin(), r.end(), [](const auto& a, const auto& b) {
     return a.position[0] != b.position[0] ? a.position[0] < b.position[0] : a.index < b.index;
   });
@@ -589,7 +589,7 @@ TEST(Streaming_sweep, GivesExactlyTheInCoreGraphWithBoundedWindow)
     options.radius = gr.radius;
     options.batch_size = batch;
     const NO::streaming::Sweep_report report = NO::streaming::sweep<CGAL::Parallel_tag, Kernel>(
-      src, [](const NO::streaming::Point_record& r) { return r.position[0]; }, options, visitor, window);
+      src, [](const NO::Point_record& r) { return r.position[0]; }, options, visitor, window);
     auto got = visitor.edges;
     std::sort(got.begin(), got.end());
     EXPECT_TRUE(visitor.in_order) << "batch " << batch;
@@ -634,7 +634,7 @@ TEST(Streaming_sweep, RefusesUnsortedInput)
   options.batch_size = 100;
   try {
     NO::streaming::sweep<CGAL::Sequential_tag, Kernel>(
-      src, [](const NO::streaming::Point_record& r) { return r.position[0]; }, options, visitor, window);
+      src, [](const NO::Point_record& r) { return r.position[0]; }, options, visitor, window);
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("not sorted"), std::string::npos);
@@ -642,7 +642,7 @@ TEST(Streaming_sweep, RefusesUnsortedInput)
   }
   options.radius = -1.0;
   EXPECT_THROW((NO::streaming::sweep<CGAL::Sequential_tag, Kernel>(
-                 src, [](const NO::streaming::Point_record& r) { return r.position[0]; }, options, visitor, window)),
+                 src, [](const NO::Point_record& r) { return r.position[0]; }, options, visitor, window)),
                std::invalid_argument);
 }
 
@@ -655,9 +655,9 @@ namespace {
 
 struct Rewindable_source
 {
-  std::vector<NO::streaming::Point_record> records;
+  std::vector<NO::Point_record> records;
   std::size_t next = 0;
-  std::size_t read(std::vector<NO::streaming::Point_record>& chunk, std::size_t maximum)
+  std::size_t read(std::vector<NO::Point_record>& chunk, std::size_t maximum)
   {
     const std::size_t m = std::min(maximum, records.size() - next);
     chunk.insert(chunk.end(), records.begin() + std::ptrdiff_t(next), records.begin() + std::ptrdiff_t(next + m));
@@ -667,9 +667,9 @@ struct Rewindable_source
   void rewind() { next = 0; }
 };
 
-std::vector<NO::streaming::Point_record> as_records(const std::vector<PN>& cloud)
+std::vector<NO::Point_record> as_records(const std::vector<PN>& cloud)
 {
-  std::vector<NO::streaming::Point_record> r;
+  std::vector<NO::Point_record> r;
   for (std::size_t i = 0; i < cloud.size(); ++i)
     r.push_back({{cloud[i].first.x(), cloud[i].first.y(), cloud[i].first.z()},
                  {cloud[i].second.x(), cloud[i].second.y(), cloud[i].second.z()},
@@ -702,12 +702,12 @@ TEST(Streaming_orient_normals, AgreesWithInCoreAndFacesOutward)
     auto in_core = input;
     const NO::Orientation_result ic = NO::orient_normals(in_core, pn_params());
     Rewindable_source src{as_records(input)};
-    std::vector<NO::streaming::Point_record> out;
-    auto sink = [&](const NO::streaming::Point_record& r) { out.push_back(r); };
+    std::vector<NO::Point_record> out;
+    auto sink = [&](const NO::Point_record& r) { out.push_back(r); };
     NO::Streaming_options options;
     options.radius = ic.neighbor_radius; // the same graph as in core
     options.batch_size = 2000;
-    options.sort.memory_budget = 200000 * sizeof(NO::streaming::Point_record) / 50; // several runs
+    options.sort.memory_budget = 200000 * sizeof(NO::Point_record) / 50; // several runs
     const NO::Streaming_result sr = NO::streaming_orient_normals(src, sink, options);
     ASSERT_EQ(out.size(), input.size());
     EXPECT_EQ(sr.number_of_points, input.size());
@@ -733,8 +733,8 @@ TEST(Streaming_orient_normals, AgreesWithInCoreAndFacesOutward)
 
     // the estimated radius is close to the in-core one
     Rewindable_source again{as_records(input)};
-    std::vector<NO::streaming::Point_record> out2;
-    auto sink2 = [&](const NO::streaming::Point_record& r) { out2.push_back(r); };
+    std::vector<NO::Point_record> out2;
+    auto sink2 = [&](const NO::Point_record& r) { out2.push_back(r); };
     NO::Streaming_options estimated;
     const NO::Streaming_result er = NO::streaming_orient_normals(again, sink2, estimated);
     EXPECT_TRUE(er.radius_estimated);

@@ -670,7 +670,7 @@ TEST(Segment_reduction, ReducedQpboINeverAboveMstAndHonoursConstraints)
 }
 
 // ---------------------------------------------------------------------------
-// The streaming segmenter with preliminary flips (streaming::Segmenter).
+// The streaming segmenter with preliminary flips (Segmenter).
 
 namespace {
 
@@ -683,14 +683,14 @@ struct Streamed_segmentation
 
 // feeds the vertices of g in index order, each with its earlier neighbours'
 // votes in their flipped frames, as the sweep will
-Streamed_segmentation stream_segments(const Ugraph& g, const NO::streaming::Segmentation_thresholds& theta)
+Streamed_segmentation stream_segments(const Ugraph& g, const NO::Segmentation_thresholds& theta)
 {
   const std::size_t n = boost::num_vertices(g);
   Streamed_segmentation s;
   s.segment.assign(n, 0);
   s.flip.assign(n, 1);
-  NO::streaming::Segmenter segmenter(theta);
-  std::vector<NO::streaming::Neighbor_vote> votes;
+  NO::Segmenter segmenter(theta);
+  std::vector<NO::Neighbor_vote> votes;
   for (std::size_t i = 0; i < n; ++i) {
     votes.clear();
     for (auto e : boost::make_iterator_range(boost::out_edges(i, g))) {
@@ -699,7 +699,7 @@ Streamed_segmentation stream_segments(const Ugraph& g, const NO::streaming::Segm
         votes.push_back({s.segment[j], get(boost::edge_weight, g, e) * s.flip[j]});
     }
     const std::size_t before = segmenter.number_of_segments();
-    const NO::streaming::Segment_assignment a = segmenter.add_point(votes);
+    const NO::Segment_assignment a = segmenter.add_point(votes);
     EXPECT_EQ(a.opened, segmenter.number_of_segments() == before + 1);
     EXPECT_LT(a.segment, segmenter.number_of_segments());
     s.segment[i] = a.segment;
@@ -723,7 +723,7 @@ TEST(Streaming_segmenter, BalancedGraphsGiveConsistentSegmentsAndAnExactSegmentG
   std::mt19937_64 rng(17);
   for (int t = 0; t < 20; ++t) {
     const Ugraph g = balanced_graph(rng, 400, 1600);
-    const Streamed_segmentation s = stream_segments(g, NO::streaming::Segmentation_thresholds());
+    const Streamed_segmentation s = stream_segments(g, NO::Segmentation_thresholds());
     ASSERT_LT(s.reduced.number_of_vertices, 400u);
     // inside a segment every edge agrees with the preliminary flips
     for (auto e : boost::make_iterator_range(boost::edges(g))) {
@@ -752,7 +752,7 @@ TEST(Streaming_segmenter, SegmentGraphEnergyIsExactUpToAConstantWithFlips)
   std::mt19937_64 rng(23);
   for (int t = 0; t < 10; ++t) {
     const Ugraph g = random_graph(rng, 300, 1500, 0.2);
-    NO::streaming::Segmentation_thresholds theta;
+    NO::Segmentation_thresholds theta;
     theta.contradiction = 0.25 * (t % 3);
     theta.acceptance = 0.3;
     const Streamed_segmentation s = stream_segments(g, theta);

@@ -4,7 +4,7 @@
 /*!
 \ingroup PkgNormalOrientationConcepts
 \cgalConcept
-\headerfile Point_record.h <Normal_orientation/streaming/Point_record.h>
+\headerfile Point_record.h <Normal_orientation/Point_record.h>
 
 Where `Normal_orientation::streaming_orient_normals()` hands the oriented points: a
 function object called once per point kept, in the sweep order, from the calling thread,
@@ -34,11 +34,11 @@ class PointRecordSink
 {
 public:
   /// receives one oriented point
-  void operator()(const Normal_orientation::streaming::Point_record& record);
+  void operator()(const Normal_orientation::Point_record& record);
   /// optional: receives one oriented point and its segment (called instead of the
   /// operator above when the sink has it)
-  void operator()(const Normal_orientation::streaming::Point_record& record, std::uint32_t segment);
+  void operator()(const Normal_orientation::Point_record& record, std::uint32_t segment);
   /// optional: receives one oriented point, its segment and whether its normal was negated
   /// (called instead of the operators above when the sink has it)
-  void operator()(const Normal_orientation::streaming::Point_record& record, std::uint32_t segment, bool flipped);
+  void operator()(const Normal_orientation::Point_record& record, std::uint32_t segment, bool flipped);
 };

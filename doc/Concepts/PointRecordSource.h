@@ -4,9 +4,9 @@
 /*!
 \ingroup PkgNormalOrientationConcepts
 \cgalConcept
-\headerfile Point_record.h <Normal_orientation/streaming/Point_record.h>
+\headerfile Point_record.h <Normal_orientation/Point_record.h>
 
-A source of `Normal_orientation::streaming::Point_record`s: what the out-of-core pipeline
+A source of `Normal_orientation::Point_record`s: what the out-of-core pipeline
 reads, chunk by chunk, so that the cloud is never held in memory as a whole (see
 \ref NormalOrientationSecStreaming).  The records carry their index in the input (0, 1,
 ...), which breaks every tie.
@@ -34,7 +34,7 @@ public:
   /// \param chunk the vector the records are appended to
   /// \param maximum the largest number of records to append
   /// \return the number of records appended
-  std::size_t read(std::vector<Normal_orientation::streaming::Point_record>& chunk, std::size_t maximum);
+  std::size_t read(std::vector<Normal_orientation::Point_record>& chunk, std::size_t maximum);
 
   /// starts again from the first record
   void rewind();

@@ -67,8 +67,6 @@ struct Neighbor_graph_report
   double radius = 0.0;
   /// true when r was estimated from the data
   bool radius_estimated = false;
-  /// the median distance from a point to its k-th nearest neighbour
-  double median_kth_distance = 0.0;
   /// the number of (undirected) edges
   std::size_t number_of_edges = 0;
   /// seconds spent in the kd-tree and the kNN queries
@@ -349,9 +347,6 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
     std::vector<float> kth(n);
     for (std::size_t i = 0; i < n; ++i)
       kth[i] = d2[i * k + (k - 1)];
-    auto mid = kth.begin() + std::ptrdiff_t(n / 2);
-    std::nth_element(kth.begin(), mid, kth.end());
-    report.median_kth_distance = std::sqrt(double(*mid));
     if (radius == 0.0) {
       auto q = kth.begin() + std::ptrdiff_t(std::min(n - 1, std::size_t(default_radius_percentile * double(n))));
       std::nth_element(kth.begin(), q, kth.end());

@@ -19,10 +19,10 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/internal/Progress.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
-#include <Normal_orientation/streaming/Point_record.h>
+#include <Normal_orientation/Point_record.h>
 #include <Normal_orientation/streaming/Record_file.h>
 #include <Normal_orientation/streaming/Refinement.h>
-#include <Normal_orientation/streaming/Segmenter.h>
+#include <Normal_orientation/Segmenter.h>
 #include <Normal_orientation/streaming/Sweep.h>
 #include <Normal_orientation/streaming/external_sort.h>
 
@@ -166,7 +166,7 @@ struct Streaming_options
   double radius = 0.0;
   /// the segmentation thresholds of the sweep (the paper's defaults:
   /// theta_S = 0, theta_acc = 0.5)
-  streaming::Segmentation_thresholds thresholds;
+  Segmentation_thresholds thresholds;
   /// The refinement after the segment graph is solved (see
   /// `streaming::Refinement_options`): rounds of re-segmentation around the
   /// current labelling, with finer and finer segments, each solved again,
@@ -267,7 +267,7 @@ namespace internal {
 /// a point after the sweep: the record, its segment and its preliminary flip
 struct Swept_record
 {
-  streaming::Point_record record;
+  Point_record record;
   std::uint32_t segment;
   std::int32_t flip;
 };
@@ -276,7 +276,7 @@ struct Swept_record
 /// the temporary group files of the component output
 struct Ranked_record
 {
-  streaming::Point_record record;
+  Point_record record;
   std::uint64_t rank;
 };
 
@@ -288,7 +288,7 @@ struct Sweep_payload
 };
 
 /// unit normal of a record (zero when the normal is zero)
-inline std::array<double, 3> unit_normal(const streaming::Point_record& r)
+inline std::array<double, 3> unit_normal(const Point_record& r)
 {
   const double l2 = r.normal[0] * r.normal[0] + r.normal[1] * r.normal[1] + r.normal[2] * r.normal[2];
   if (!(l2 > 0.0))
@@ -300,11 +300,11 @@ inline std::array<double, 3> unit_normal(const streaming::Point_record& r)
 /// Hands `record` to `sink`, with the segment of the point and whether its
 /// normal was negated when the sink takes them (see `PointRecordSink`).
 template <typename Sink>
-void hand_to_sink(Sink& sink, const streaming::Point_record& record, std::uint32_t segment, bool flipped)
+void hand_to_sink(Sink& sink, const Point_record& record, std::uint32_t segment, bool flipped)
 {
-  if constexpr (std::is_invocable_v<Sink&, const streaming::Point_record&, std::uint32_t, bool>)
+  if constexpr (std::is_invocable_v<Sink&, const Point_record&, std::uint32_t, bool>)
     sink(record, segment, flipped);
-  else if constexpr (std::is_invocable_v<Sink&, const streaming::Point_record&, std::uint32_t>)
+  else if constexpr (std::is_invocable_v<Sink&, const Point_record&, std::uint32_t>)
     sink(record, segment);
   else
     sink(record);
@@ -343,7 +343,7 @@ public:
   Reporting_source(Source& source, const Streaming_reporter& report, Streaming_stage stage, std::uint64_t total)
     : m_source(source), m_report(report), m_stage(stage), m_total(total)
   {}
-  std::size_t read(std::vector<streaming::Point_record>& chunk, std::size_t maximum)
+  std::size_t read(std::vector<Point_record>& chunk, std::size_t maximum)
   {
     const std::size_t got = m_source.read(chunk, maximum);
     m_count += got;
@@ -427,7 +427,7 @@ private:
 
 /// \ingroup PkgNormalOrientationStreaming
 /// Orients the points of `source` out of core and hands them to `sink`
-/// (`sink(const streaming::Point_record&)`, called once per point kept, in
+/// (`sink(const Point_record&)`, called once per point kept, in
 /// the sweep order, with the oriented normal: only its sign differs from the
 /// input's; a sink callable as `sink(record, std::uint32_t segment)` is
 /// called so, with the segment of the point: the segments are numbered 0 to
@@ -453,7 +453,7 @@ private:
 ///     w = phi * (1 - d^2 / r^2) (in parallel per batch, with the input
 ///     normals; the neighbours' preliminary flips multiply them, as labels
 ///     do in core) and is
-///     segmented (`streaming::Segmenter`); points leaving the window
+///     segmented (`Segmenter`); points leaving the window
 ///     go to a temporary record file (the sort's files are removed then);
 ///  5. `solver` on the segment graph (a BGL graph);
 ///  6. the outward sign of every connected component, from two passes over
@@ -532,7 +532,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     streaming::internal::Moment_accumulator moments;
     const std::size_t m = 200000;
     std::mt19937_64 rng(0x5eed);
-    std::vector<streaming::Point_record> chunk;
+    std::vector<Point_record> chunk;
     chunk.reserve(65536);
     double last = -HUGE_VAL;
     source.rewind();
@@ -540,7 +540,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
       chunk.clear();
       if (source.read(chunk, 65536) == 0)
         break;
-      for (const streaming::Point_record& r : chunk) {
+      for (const Point_record& r : chunk) {
         const bool finite = std::isfinite(r.position[0]) && std::isfinite(r.position[1]) && std::isfinite(r.position[2]);
         if (!finite)
           ++non_finite;
@@ -642,20 +642,20 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   std::unique_ptr<streaming::Record_file<streaming::Earlier_edge>> edges;
   if (refine)
     edges = std::make_unique<streaming::Record_file<streaming::Earlier_edge>>(options.temporary_directory, 1 << 16);
-  streaming::Segmenter segmenter(options.thresholds);
+  Segmenter segmenter(options.thresholds);
   std::vector<std::uint64_t> segment_size;
   const double r2 = radius * radius;
   struct Visitor
   {
     const FlipCriterion& criterion;
-    streaming::Segmenter& segmenter;
+    Segmenter& segmenter;
     streaming::Record_file<internal::Swept_record>& records;
     streaming::Record_file<streaming::Earlier_edge>* edges;
     std::vector<std::uint64_t>& segment_size;
     double r2;
     const internal::Streaming_reporter& report;
     std::uint64_t n;
-    std::vector<streaming::Neighbor_vote> votes;
+    std::vector<Neighbor_vote> votes;
     std::uint64_t span = 0; // the farthest back an edge reaches
 
     // The edge weights of a whole batch, in parallel, with the input
@@ -671,12 +671,12 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
       cursor = 0;
       internal::parallel_chunks<ConcurrencyTag>(offsets.size() - 1, [&](std::size_t b, std::size_t e) {
         for (std::size_t q = b; q < e; ++q) {
-          const streaming::Point_record& p = w.record(first + q);
+          const Point_record& p = w.record(first + q);
           const std::array<double, 3> np = internal::unit_normal(p);
           const Point pp(p.position[0], p.position[1], p.position[2]);
           const Vector vp(np[0], np[1], np[2]);
           for (std::size_t t = offsets[q]; t < offsets[q + 1]; ++t) {
-            const streaming::Point_record& o = w.record(neighbors[t].sequence);
+            const Point_record& o = w.record(neighbors[t].sequence);
             const std::array<double, 3> no = internal::unit_normal(o);
             const double omega = 1.0 - double(neighbors[t].squared_distance) / r2;
             weights[t] = float(criterion(pp, vp, Point(o.position[0], o.position[1], o.position[2]),
@@ -705,7 +705,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
         if (edges != nullptr)
           edges->append(streaming::Earlier_edge{std::uint32_t(s - nb.sequence), weight});
       }
-      const streaming::Segment_assignment a = segmenter.add_point(votes);
+      const Segment_assignment a = segmenter.add_point(votes);
       w.payload(s) = internal::Sweep_payload{a.segment, a.flip};
       if (a.segment >= segment_size.size())
         segment_size.resize(a.segment + 1, 0);
@@ -723,9 +723,9 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   so.batch_size = options.batch_size;
   const streaming::Sweep_report sr =
     presorted ? streaming::sweep<ConcurrencyTag, Kernel>(
-                  source, [axis](const streaming::Point_record& r) { return r.position[axis]; }, so, visitor, window)
+                  source, [axis](const Point_record& r) { return r.position[axis]; }, so, visitor, window)
               : streaming::sweep<ConcurrencyTag, Kernel>(
-                  sorted, [&frame](const streaming::Point_record& r) { return frame.key(r); }, so, visitor, window);
+                  sorted, [&frame](const Point_record& r) { return frame.key(r); }, so, visitor, window);
   sorted = streaming::Sorted_run_reader(); // removes the sort's files
   if (presorted)
     source.rewind();
@@ -779,9 +779,9 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     std::unique_ptr<streaming::Record_file<std::uint32_t>> in, out;
     std::uint64_t done = 0;
     for (unsigned int round = 0; round < rounds; ++round) {
-      streaming::Segmentation_thresholds theta = options.refinement.thresholds;
+      Segmentation_thresholds theta = options.refinement.thresholds;
       theta.maximum_size = options.refinement.maximum_segment_size(n, round);
-      streaming::Segmenter resegmenter(theta, false);
+      Segmenter resegmenter(theta, false);
       out = std::make_unique<streaming::Record_file<std::uint32_t>>(options.temporary_directory, 1 << 16);
       streaming::internal::Relabelling_window pass(result.edge_span, &resegmenter, false);
       auto write = [&out](Label label, std::uint32_t segment) {
@@ -981,7 +981,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
     kept = order.size();
   }
   // the final record of a swept point; true when its normal was turned
-  auto finish = [&](const internal::Swept_record& s, Label point_label, streaming::Point_record& out) {
+  auto finish = [&](const internal::Swept_record& s, Label point_label, Point_record& out) {
     out = s.record;
     const int label = int(point_label) * (flip_component[component[s.segment]] ? -1 : 1);
     if (label >= 0)
@@ -997,7 +997,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
   rewind_points();
   {
     std::uint64_t read = 0;
-    streaming::Point_record out;
+    Point_record out;
     while (read_points() > 0) {
       read += buffer.size();
       for (std::size_t q = 0; q < buffer.size(); ++q) {
@@ -1039,7 +1039,7 @@ Streaming_result streaming_orient_normals(Source& source, Sink& sink, const Stre
       }
       writers.clear();
     };
-    streaming::Point_record out;
+    Point_record out;
     if (groups == 1) {
       open_writers(0, kept);
       rewind_points();
@@ -1156,7 +1156,7 @@ Streaming_result streaming_orient_files(const std::string& input, const std::str
     o.component_files.extension = std::filesystem::path(output).extension().string();
     o.component_files.write_options = write_options;
   }
-  auto sink = [&writer](const streaming::Point_record& r, std::uint32_t segment) {
+  auto sink = [&writer](const Point_record& r, std::uint32_t segment) {
     if (writer.has_segments())
       writer.write(r, segment);
     else
@@ -1242,7 +1242,7 @@ Streaming_result streaming_orient_files_in_input_order(const std::string& input,
     }
     return options.callback ? options.callback(p) : true;
   };
-  auto sink = [&](const streaming::Point_record& r, std::uint32_t, bool flipped) {
+  auto sink = [&](const Point_record& r, std::uint32_t, bool flipped) {
     keep.set(r.index); // throws std::out_of_range on an index beyond the count
     if (flipped)
       flip.set(r.index);

@@ -6,7 +6,7 @@
 ///
 /// `Point_stream_reader` reads the same files as `read_point_cloud()` and gives, point
 /// by point and bit for bit, the same coordinates and normals, as
-/// `streaming::Point_record`s numbered 0, 1, ... in file order. It reports the same
+/// `Point_record`s numbered 0, 1, ... in file order. It reports the same
 /// errors with the same messages (bytes after the last element of a binary PLY file
 /// included, with their byte offset). Errors are found as the data are read, so an error in
 /// the middle of the file is reported by the `read()` call that reaches it (header
@@ -19,7 +19,7 @@
 #define NORMAL_ORIENTATION_IO_POINT_STREAM_H
 
 #include <Normal_orientation/IO/Point_cloud_io.h>
-#include <Normal_orientation/streaming/Point_record.h>
+#include <Normal_orientation/Point_record.h>
 
 #include <algorithm>
 #include <array>
@@ -386,7 +386,7 @@ public:
   /// have their index in the file (0, 1, ...) as `index`.
   /// \throws Io_error on any error in the data (records read before the error in this
   /// call may have been appended); `read()` then throws the same error until `rewind()`.
-  std::size_t read(std::vector<streaming::Point_record>& chunk, std::size_t maximum)
+  std::size_t read(std::vector<Point_record>& chunk, std::size_t maximum)
   {
     if(!error_.empty()) throw Io_error(error_);
     try {
@@ -484,7 +484,7 @@ private:
     }
   }
 
-  std::size_t read_xyz_records(std::vector<streaming::Point_record>& chunk, std::size_t maximum)
+  std::size_t read_xyz_records(std::vector<Point_record>& chunk, std::size_t maximum)
   {
     std::size_t count = 0;
     std::array<double, 6> values{};
@@ -494,7 +494,7 @@ private:
         finished_ = true;
         break;
       }
-      streaming::Point_record record{};
+      Point_record record{};
       for(std::size_t c = 0; c < 3; ++c) record.position[c] = values[c];
       if(n == 6)
         for(std::size_t c = 0; c < 3; ++c) record.normal[c] = values[3 + c];
@@ -661,7 +661,7 @@ private:
     }
   }
 
-  std::size_t read_ascii_records(std::vector<streaming::Point_record>& chunk, std::size_t maximum)
+  std::size_t read_ascii_records(std::vector<Point_record>& chunk, std::size_t maximum)
   {
     using namespace internal;
     const Ply_header_element& vertex = elements_[vertex_element_];
@@ -671,7 +671,7 @@ private:
       const char* eol = nullptr;
       if(!next_nonblank_line(first, eol)) fail(filename_, truncated_message(vertex, static_cast<std::size_t>(next_index_)));
       parse_ascii_row(filename_, vertex, first, eol, line_, row_values_.data());
-      streaming::Point_record record{};
+      Point_record record{};
       for(std::size_t j = 0; j < roles_.size(); ++j) {
         const std::size_t role = roles_[j];
         if(role < 3) record.position[role] = row_values_[j];
@@ -684,7 +684,7 @@ private:
     return count;
   }
 
-  std::size_t read_binary_records(std::vector<streaming::Point_record>& chunk, std::size_t maximum)
+  std::size_t read_binary_records(std::vector<Point_record>& chunk, std::size_t maximum)
   {
     using namespace internal;
     std::size_t count = 0;
@@ -696,7 +696,7 @@ private:
         {input_->available() / row_size_, maximum - count, expected_count_ - next_index_}));
       const char* p = input_->data();
       for(std::size_t r = 0; r < rows; ++r, p += row_size_) {
-        streaming::Point_record record{};
+        Point_record record{};
         for(const Binary_field& field : fields_) {
           const double value = load_scalar(p + field.offset, field.type, swap_);
           if(field.role < 3) record.position[field.role] = value;
@@ -751,13 +751,13 @@ struct Point_stream_write_options
   /// Write the normals (`nx ny nz`) of the records; only `x y z` otherwise.
   bool normals = true;
   /// PLY only: add the vertex property `int segment`, after the others, whose values are
-  /// given to `Point_stream_writer::write(const streaming::Point_record&, std::uint32_t)`
+  /// given to `Point_stream_writer::write(const Point_record&, std::uint32_t)`
   /// (`streaming_orient_files()` writes there the segment of each point). A `.xyz`/`.pwn`
   /// file cannot hold it: the writer's constructor throws `Io_error` then.
   bool segments = false;
 };
 
-/// \brief Sequential writer of `streaming::Point_record`s to a point cloud file.
+/// \brief Sequential writer of `Point_record`s to a point cloud file.
 ///
 /// The format is chosen from the extension (case-insensitive): `.xyz` and `.pwn` write
 /// one line `x y z nx ny nz` (or `x y z`) per record, each value with the shortest text
@@ -828,18 +828,18 @@ public:
   /// \brief Writes `record` (its position and, if `has_normals()`, its normal).
   /// \throws Io_error if a value is not finite (nothing of the record is written then),
   /// on a writing error, after `commit()`, or if `has_segments()` (a segment is needed).
-  void write(const streaming::Point_record& record)
+  void write(const Point_record& record)
   {
     if(options_.segments) internal::fail(filename_, "cannot write a point without its segment");
     write_values(record, 0);
   }
 
-  /// \brief Writes `record` as `write(const streaming::Point_record&)` does, followed by
+  /// \brief Writes `record` as `write(const Point_record&)` does, followed by
   /// `segment` (the `int segment` property).
-  /// \throws Io_error as `write(const streaming::Point_record&)`, if `has_segments()` is
+  /// \throws Io_error as `write(const Point_record&)`, if `has_segments()` is
   /// `false`, or if `segment` exceeds the range of `int` (2^31 - 1); nothing of the
   /// record is written then.
-  void write(const streaming::Point_record& record, std::uint32_t segment)
+  void write(const Point_record& record, std::uint32_t segment)
   {
     if(!options_.segments) internal::fail(filename_, "cannot write a segment: segments are not enabled");
     if(segment > 2147483647u)
@@ -848,11 +848,11 @@ public:
   }
 
   /// \brief Writes the records of `records`, in order.
-  /// \throws Io_error as `write(const streaming::Point_record&)`; the records before
+  /// \throws Io_error as `write(const Point_record&)`; the records before
   /// the faulty one are written.
-  void write(const std::vector<streaming::Point_record>& records)
+  void write(const std::vector<Point_record>& records)
   {
-    for(const streaming::Point_record& record : records) write(record);
+    for(const Point_record& record : records) write(record);
   }
 
   /// \brief Completes the file (PLY: sets the vertex count in the header) and renames
@@ -877,7 +877,7 @@ private:
   static constexpr std::size_t count_width = 20;
 
   /// Writes `record` and, if `has_segments()`, `segment` (at most 2^31 - 1).
-  void write_values(const streaming::Point_record& record, std::uint32_t segment)
+  void write_values(const Point_record& record, std::uint32_t segment)
   {
     using namespace internal;
     if(committed_) fail(filename_, "cannot write: the file was already committed");

@@ -17,7 +17,7 @@
 #include <Normal_orientation/IO/Point_cloud_io.h>
 #include <Normal_orientation/IO/Point_stream.h>
 #include <Normal_orientation/internal/Progress.h>
-#include <Normal_orientation/streaming/Point_record.h>
+#include <Normal_orientation/Point_record.h>
 
 #include <algorithm>
 #include <array>
@@ -338,7 +338,7 @@ public:
       raw.seek(layout_->vertex_data_offset);
     }
     const bool binary = ply() && layout_->format != Ply_format::ASCII;
-    std::vector<streaming::Point_record> chunk;
+    std::vector<Point_record> chunk;
     chunk.reserve(chunk_size);
     for(;;) {
       chunk.clear();
@@ -408,7 +408,7 @@ private:
   void put(const char* begin, const char* end) { out_->put(std::string_view(begin, static_cast<std::size_t>(end - begin))); }
 
   /// Copies the binary rows of the points of `chunk`, which the reader has just read.
-  void copy_binary_rows(const std::vector<streaming::Point_record>& chunk)
+  void copy_binary_rows(const std::vector<Point_record>& chunk)
   {
     const std::size_t row_size = layout_->row_size;
     const bool big_endian = layout_->format == Ply_format::BINARY_BIG_ENDIAN;
@@ -461,9 +461,9 @@ private:
 
   /// Copies the lines of the points of `chunk`, which the reader has just read, and the
   /// comment and blank lines before each.
-  void copy_text_rows(const std::vector<streaming::Point_record>& chunk)
+  void copy_text_rows(const std::vector<Point_record>& chunk)
   {
-    for(const streaming::Point_record& record : chunk) {
+    for(const Point_record& record : chunk) {
       for(;;) {
         const char* first = nullptr;
         const char* eol = nullptr;
@@ -514,7 +514,7 @@ private:
 
   /// Writes the line `[first, eol)` of the point `record`, ended by `[eol, next)`, with
   /// its normal negated.
-  void put_flipped_line(const char* first, const char* eol, const char* next, const streaming::Point_record& record)
+  void put_flipped_line(const char* first, const char* eol, const char* next, const Point_record& record)
   {
     const char* copied = first; // [first, copied) is written
     const char* q = first;
@@ -579,7 +579,7 @@ private:
 /// whose bit is clear in `*keep` left out, and everything else as it is.
 ///
 /// Points are numbered 0, 1, ... in file order, as `Point_stream_reader` numbers them
-/// (`streaming::Point_record::index`). `flip` has one bit per point of the file, or none
+/// (`Point_record::index`). `flip` has one bit per point of the file, or none
 /// at all (no normal is negated); `keep` is null (every point is kept) or has one bit per
 /// point. The file is read with the rules and the error messages of
 /// `Point_stream_reader` (the formats of `read_point_cloud()`), and `output` must have

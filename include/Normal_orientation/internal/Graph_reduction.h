@@ -11,7 +11,7 @@
 /// full problem that keep every segment rigid.
 
 #include <Normal_orientation/Orientation_problem.h>
-#include <Normal_orientation/streaming/Segmenter.h>
+#include <Normal_orientation/Segmenter.h>
 
 #include <boost/graph/graph_traits.hpp>
 #include <boost/graph/properties.hpp>
@@ -214,7 +214,7 @@ inline std::size_t improve_by_sweeps(const Incidence& inc, const std::vector<dou
 }
 
 /// the thresholds of the segmentation
-typedef streaming::Segmentation_thresholds Segmentation_thresholds;
+typedef Segmentation_thresholds Segmentation_thresholds;
 
 /// A segmentation of a problem and the problem it reduces to.
 struct Segment_reduction
@@ -228,7 +228,7 @@ struct Segment_reduction
 };
 
 /// Segments the problem of `inc` around the labelling `start` in vertex
-/// order, with the paper's segmentation (`streaming::Segmenter`) in the
+/// order, with the paper's segmentation (`Segmenter`) in the
 /// frame where `start` is all +1 (vote(i, j) = w_ij * L_i * L_j), and
 /// without flips (`may_flip = false`): vertex i joins the segment of its
 /// earlier neighbours whose vote is largest among the valid ones, or opens
@@ -245,8 +245,8 @@ inline Segment_reduction reduce_to_segments(const Incidence& inc, const std::vec
   const std::size_t n = inc.number_of_vertices();
   Segment_reduction r;
   r.segment.assign(n, 0);
-  streaming::Segmenter segmenter(theta, false);
-  std::vector<streaming::Neighbor_vote> votes;
+  Segmenter segmenter(theta, false);
+  std::vector<Neighbor_vote> votes;
   for (std::size_t i = 0; i < n; ++i) {
     votes.clear();
     for (std::uint32_t t = inc.first[i]; t < inc.first[i + 1]; ++t) {
@@ -257,7 +257,7 @@ inline Segment_reduction reduce_to_segments(const Incidence& inc, const std::vec
     r.segment[i] = segmenter.add_point(votes, preference.empty() ? 0.0 : preference[i] * double(start[i])).segment;
   }
 
-  const streaming::internal::Segment_pair_weights& between = segmenter.segment_pairs();
+  const Segment_pair_weights& between = segmenter.segment_pairs();
   Array_problem& q = r.reduced;
   q.number_of_vertices = segmenter.number_of_segments();
   q.tail.reserve(between.size());

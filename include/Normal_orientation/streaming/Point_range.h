@@ -10,7 +10,7 @@
 /// oriented normals back into a random-access range.
 
 #include <Normal_orientation/parameters.h>
-#include <Normal_orientation/streaming/Point_record.h>
+#include <Normal_orientation/Point_record.h>
 
 #include <CGAL/boost/graph/named_params_helper.h>
 #include <CGAL/property_map.h>

@@ -17,7 +17,7 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/internal/Qpbo.h>
 #include <Normal_orientation/streaming/Record_file.h>
-#include <Normal_orientation/streaming/Segmenter.h>
+#include <Normal_orientation/Segmenter.h>
 
 #include <CGAL/property_map.h>
 

@@ -12,7 +12,7 @@
 
 #include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/internal/Future_waiter.h>
-#include <Normal_orientation/streaming/Point_record.h>
+#include <Normal_orientation/Point_record.h>
 
 #include <CGAL/Kd_tree.h>
 #include <CGAL/Orthogonal_k_neighbor_search.h>

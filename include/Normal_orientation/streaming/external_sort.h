@@ -26,7 +26,7 @@
 ///
 /// POSIX only (`mkstemp`, `pread`, `unlink`).
 
-#include <Normal_orientation/streaming/Point_record.h>
+#include <Normal_orientation/Point_record.h>
 
 #if !defined(__unix__) && !defined(__APPLE__)
 #error "Normal_orientation/streaming/external_sort.h needs POSIX (mkstemp, pread, unlink)"

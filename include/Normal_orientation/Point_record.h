@@ -1,19 +1,17 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // This file is part of Normal_orientation.
-#ifndef NORMAL_ORIENTATION_STREAMING_POINT_RECORD_H
-#define NORMAL_ORIENTATION_STREAMING_POINT_RECORD_H
+#ifndef NORMAL_ORIENTATION_POINT_RECORD_H
+#define NORMAL_ORIENTATION_POINT_RECORD_H
 
 /// \file Point_record.h
-/// The unit of data of the streaming (out-of-core) pipeline: one point with
-/// its normal and its position in the input, as it travels through the
-/// streaming readers, the external sort, the sweep and the temporary record
-/// files.
+/// One point with its normal and its position in the input: the unit of
+/// data of the streaming readers and writers, the external sort, the sweep
+/// and the temporary record files.
 
 #include <cstdint>
 #include <type_traits>
 
 namespace Normal_orientation {
-namespace streaming {
 
 /// \ingroup PkgNormalOrientationStreaming
 /// One point of a streamed cloud: its coordinates and normal exactly as
@@ -34,7 +32,6 @@ struct Point_record
 static_assert(std::is_trivially_copyable<Point_record>::value, "Point_record is written to files as bytes");
 static_assert(sizeof(Point_record) == 56, "Point_record has no padding");
 
-} // namespace streaming
 } // namespace Normal_orientation
 
-#endif // NORMAL_ORIENTATION_STREAMING_POINT_RECORD_H
+#endif // NORMAL_ORIENTATION_POINT_RECORD_H

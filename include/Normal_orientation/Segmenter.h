@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // This file is part of Normal_orientation.
-#ifndef NORMAL_ORIENTATION_STREAMING_SEGMENTER_H
-#define NORMAL_ORIENTATION_STREAMING_SEGMENTER_H
+#ifndef NORMAL_ORIENTATION_SEGMENTER_H
+#define NORMAL_ORIENTATION_SEGMENTER_H
 
 /// \file Segmenter.h
 /// The segmentation of the paper (sec. 5.1, supplement sec. 3), one point at
@@ -20,7 +20,6 @@
 #include <vector>
 
 namespace Normal_orientation {
-namespace streaming {
 
 /// \ingroup PkgNormalOrientationStreaming
 /// The thresholds of the segmentation (paper sec. 5.1, supplement eq. 5-7).
@@ -59,12 +58,11 @@ struct Segment_assignment
   bool opened;
 };
 
-/// \cond SKIP_IN_MANUAL
-namespace internal {
-
-/// An open-addressing hash map from a pair of segment numbers (a < b) to
-/// the sum of the weights between them and the sum of their absolute
-/// values, in insertion order.
+/// \ingroup PkgNormalOrientationStreaming
+/// The edges of a segment graph as `Segmenter` accumulates them: an
+/// open-addressing hash map from a pair of segment numbers (a < b) to the
+/// sum of the weights between them and the sum of their absolute values,
+/// in insertion order (pair t: `first(t)`, `second(t)`, `weight(t)`).
 class Segment_pair_weights
 {
 public:
@@ -149,9 +147,6 @@ private:
   std::vector<std::uint64_t> m_key;
   std::vector<double> m_weight, m_absolute;
 };
-
-} // namespace internal
-/// \endcond
 
 /// \ingroup PkgNormalOrientationStreaming
 /// The paper's segmentation, one point at a time (sec. 5.1; supplement
@@ -267,13 +262,10 @@ public:
   std::size_t number_of_points() const { return m_points; }
   /// the accumulated weights between segments (the segment graph's edges,
   /// in the order their pairs first met; a weight may be zero)
-  const internal::Segment_pair_weights& segment_pairs() const { return m_between; }
+  const Segment_pair_weights& segment_pairs() const { return m_between; }
   /// the summed unary preference of each segment, in the frame of its
   /// preliminary orientation
   const std::vector<double>& segment_preferences() const { return m_preference; }
-  /// the energy of the edges inside the segments (in the preliminary
-  /// orientation; the same for every labelling that keeps the segments rigid)
-  double energy_inside_segments() const { return m_inside; }
   /// The energy of the edges seen so far (the votes; `edge_energy()`
   /// summed over them) for the labelling that gives the points of each
   /// segment s their preliminary orientation times `x[s]`: the energy
@@ -298,7 +290,7 @@ private:
 
   Segmentation_thresholds m_theta;
   bool m_may_flip;
-  internal::Segment_pair_weights m_between;
+  Segment_pair_weights m_between;
   std::vector<double> m_preference;
   std::vector<std::size_t> m_size;
   std::vector<Sum> m_sums;
@@ -306,7 +298,6 @@ private:
   double m_inside = 0.0;
 };
 
-} // namespace streaming
 } // namespace Normal_orientation
 
-#endif // NORMAL_ORIENTATION_STREAMING_SEGMENTER_H
+#endif // NORMAL_ORIENTATION_SEGMENTER_H
