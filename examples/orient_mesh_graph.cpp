@@ -104,7 +104,7 @@ int main(int argc, char** argv)
   }
   const NO::Component_sign_input<Kernel> input{points, unit_normals, labels, component, number_of_components,
                                                0.0, nullptr};
-  const std::vector<char> flip = NO::Outward_component_sign()(input);
+  const std::vector<char> flip = NO::component_signs(NO::Outward_component_sign(), input);
 
   // Apply the labels, and compare with the truth.
   std::size_t agree = 0, zero = 0;

@@ -39,6 +39,7 @@
 #include <vector>
 
 namespace NO = Normal_orientation;
+namespace NP = Normal_orientation::parameters;
 typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
 typedef Kernel::Point_3 Point;
 typedef Kernel::Vector_3 Vector;
@@ -399,14 +400,14 @@ public:
   ~Stage_progress_line() { finish(); }
   Stage_progress_line(const Stage_progress_line&) = delete;
   Stage_progress_line& operator=(const Stage_progress_line&) = delete;
-  bool operator()(const NO::Streaming_progress& p)
+  bool operator()(const NO::Progress_info& p)
   {
     if (!m_enabled)
       return true;
     const auto now = std::chrono::steady_clock::now();
     if (std::chrono::duration<double>(now - m_start).count() < 0.5)
       return true;
-    const int percent = p.total > 0 ? int(p.fraction() * 100.0) : -1;
+    const int percent = p.total > 0 ? int(p.stage_fraction() * 100.0) : -1;
     const bool same = p.stage == m_stage && percent == m_percent;
     if (same && (percent >= 0 || std::chrono::duration<double>(now - m_drawn_at).count() < 0.25))
       return true;
@@ -416,11 +417,11 @@ public:
     char line[96];
     if (percent >= 0) {
       const int width = 40, filled = percent * width / 100;
-      std::snprintf(line, sizeof line, "%-10s [%s%s] %3d%%", NO::streaming_stage_name(p.stage),
+      std::snprintf(line, sizeof line, "%-10s [%s%s] %3d%%", NO::stage_name(p.stage),
                     std::string(std::size_t(filled), '#').c_str(), std::string(std::size_t(width - filled), ' ').c_str(),
                     percent);
     } else
-      std::snprintf(line, sizeof line, "%-10s %llu points", NO::streaming_stage_name(p.stage),
+      std::snprintf(line, sizeof line, "%-10s %llu points", NO::stage_name(p.stage),
                     (unsigned long long)p.done);
     std::fprintf(stderr, "\r%-60s", line);
     m_drawn = true;
@@ -436,7 +437,7 @@ public:
 private:
   bool m_enabled;
   std::chrono::steady_clock::time_point m_start, m_drawn_at;
-  NO::Streaming_stage m_stage = NO::Streaming_stage::SCAN;
+  NO::Stage m_stage = NO::Stage::SCAN;
   int m_percent = -2;
   bool m_drawn = false;
 };
@@ -494,29 +495,33 @@ NO::Orientation_result run_with_criterion(Range& range, const Np& np, const Opti
 /// --stream: the out-of-core pipeline, file to file.
 int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
 {
-  NO::Streaming_options so;
-  so.number_of_neighbors = o.k;
-  so.radius = o.radius;
-  so.presorted_axis = o.presorted == "x"   ? NO::Presorted_axis::X
-                      : o.presorted == "y" ? NO::Presorted_axis::Y
-                      : o.presorted == "z" ? NO::Presorted_axis::Z
-                                           : NO::Presorted_axis::NONE;
-  so.minimum_component_size = o.min_component_size;
-  if (o.batch_size != 0)
-    so.batch_size = std::size_t(o.batch_size);
-  if (o.refine_rounds >= 0)
-    so.refinement.rounds = unsigned(o.refine_rounds);
-  so.component_files.directory = o.components_dir; // in OUT's format
+  const NO::Presorted_axis axis = o.presorted == "x"   ? NO::Presorted_axis::X
+                                  : o.presorted == "y" ? NO::Presorted_axis::Y
+                                  : o.presorted == "z" ? NO::Presorted_axis::Z
+                                                       : NO::Presorted_axis::NONE;
+  NO::Component_files_options component_files;
+  component_files.directory = o.components_dir; // in OUT's format
+  const unsigned int refine_rounds =
+    o.refine_rounds >= 0 ? unsigned(o.refine_rounds) : NO::streaming::Refinement_options().rounds;
   Stage_progress_line progress(!o.quiet);
-  so.callback = [&progress](const NO::Streaming_progress& p) { return progress(p); };
+  const auto np = NP::number_of_neighbors(o.k)
+                    .neighbor_radius(o.radius)
+                    .presorted_axis(axis)
+                    .minimum_component_size(std::uint64_t(o.min_component_size))
+                    .batch_size(o.batch_size != 0 ? std::size_t(o.batch_size) : std::size_t(1) << 18)
+                    .refinement_rounds(refine_rounds)
+                    .component_files(component_files)
+                    .number_of_threads(o.threads)
+                    .callback([&progress](const NO::Progress_info& p) { return progress(p); });
   NO::IO::Point_stream_write_options wo;
   wo.binary = !o.ascii;
   wo.segments = o.write_segments;
   NO::Streaming_result r;
   auto run = [&](const auto& criterion, const auto& solver) {
     if (o.keep_order)
-      return NO::streaming_orient_files_in_input_order(o.input, o.output, so, criterion, solver);
-    return NO::streaming_orient_files(o.input, o.output, so, criterion, solver, wo);
+      return NO::streaming_orient_files_in_input_order(o.input, o.output,
+                                                       np.flip_criterion(criterion).solver(solver));
+    return NO::streaming_orient_files(o.input, o.output, np.flip_criterion(criterion).solver(solver), wo);
   };
   auto with_solver = [&](const auto& criterion) {
     if (o.solver == "mst")
@@ -525,14 +530,12 @@ int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
       return run(criterion, NO::Lsa_tr_solver());
     return run(criterion, NO::Qpbo_i_solver(o.orders, o.seed));
   };
-  NO::internal::run_with_threads(o.threads, [&]() {
-    if (o.criterion == "xie")
-      r = with_solver(NO::Xie_criterion());
-    else if (o.criterion == "konig")
-      r = with_solver(NO::Konig_criterion());
-    else
-      r = with_solver(NO::Hoppe_criterion());
-  });
+  if (o.criterion == "xie")
+    r = with_solver(NO::Xie_criterion());
+  else if (o.criterion == "konig")
+    r = with_solver(NO::Konig_criterion());
+  else
+    r = with_solver(NO::Hoppe_criterion());
   progress.finish();
   const double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (!o.quiet) {
@@ -576,7 +579,7 @@ int run_stream(const Options& o, std::chrono::steady_clock::time_point t0)
                 o.presorted.empty() ? "null" : ("\"" + o.presorted + "\"").c_str(), o.keep_order ? "true" : "false", r.peak_window, o.k,
                 r.neighbor_radius, r.radius_estimated ? "true" : "false",
                 o.criterion.c_str(), o.solver.c_str(), o.threads, r.segment_energy_before, r.segment_energy_after,
-                so.refinement.rounds, r.refinement_rounds_accepted, (unsigned long long)r.refinement_moves,
+                refine_rounds, r.refinement_rounds_accepted, (unsigned long long)r.refinement_moves,
                 r.energy_before_refinement, r.energy_after_refinement, (unsigned long long)r.edge_span,
                 (unsigned long long)r.number_of_flipped, r.seconds.frame, r.seconds.radius, r.seconds.sort,
                 r.seconds.sweep, r.seconds.solve, r.seconds.refine, r.seconds.sign, r.seconds.output,

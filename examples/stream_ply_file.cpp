@@ -26,27 +26,27 @@ namespace NO = Normal_orientation;
 
 int main(int argc, char** argv)
 {
-  NO::Streaming_options options;
   const std::string axis = argc == 5 ? argv[4] : "";
   const bool axis_ok = axis == "x" || axis == "y" || axis == "z";
   if ((argc != 3 && argc != 5) || (argc == 5 && (std::string(argv[3]) != "--presorted" || !axis_ok))) {
     std::cerr << "usage: stream_ply_file IN(.ply|.xyz, with normals) OUT(.ply|.xyz) [--presorted x|y|z]\n";
     return 2;
   }
-  if (!axis.empty())
-    options.presorted_axis =
-      axis == "x" ? NO::Presorted_axis::X : axis == "y" ? NO::Presorted_axis::Y : NO::Presorted_axis::Z;
+  const NO::Presorted_axis presorted = axis.empty() ? NO::Presorted_axis::NONE
+                                      : axis == "x"  ? NO::Presorted_axis::X
+                                      : axis == "y"  ? NO::Presorted_axis::Y
+                                                     : NO::Presorted_axis::Z;
 
   // The stages, as they start, and how far each goes, on the standard error.
   int stage = -1; // the stage shown, -1 before the first report
-  options.callback = [&stage, shown = -1](const NO::Streaming_progress& p) mutable {
+  auto progress = [&stage, shown = -1](const NO::Progress_info& p) mutable {
     if (int(p.stage) != stage) {
-      std::cerr << (stage < 0 ? "" : "\n") << NO::streaming_stage_name(p.stage) << ":";
+      std::cerr << (stage < 0 ? "" : "\n") << NO::stage_name(p.stage) << ":";
       stage = int(p.stage);
       shown = -1;
     }
-    if (int(10 * p.fraction()) > shown)
-      std::cerr << " " << 10 * (shown = int(10 * p.fraction())) << "%";
+    if (int(10 * p.stage_fraction()) > shown)
+      std::cerr << " " << 10 * (shown = int(10 * p.stage_fraction())) << "%";
     return true; // false would stop the run (temporary files removed, OUT not written)
   };
 
@@ -60,8 +60,9 @@ int main(int argc, char** argv)
     NO::IO::Point_stream_writer writer(argv[2], write_options);
     auto sink = [&writer](const NO::Point_record& record) { writer.write(record); };
 
-    const NO::Streaming_result r =
-      NO::streaming_orient_normals(reader, sink, options, NO::Hoppe_criterion(), NO::Qpbo_i_solver());
+    const NO::Streaming_result r = NO::streaming_orient_normals(
+      reader, sink,
+      NO::parameters::presorted_axis(presorted).flip_criterion(NO::Hoppe_criterion()).callback(progress));
     std::cerr << (stage < 0 ? "" : "\n");
     if (r.number_of_points == 0) {
       std::cerr << "stream_ply_file: " << argv[1] << " holds no point\n";

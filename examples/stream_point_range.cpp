@@ -45,9 +45,8 @@ int main(int argc, char** argv)
 
     auto source = NO::streaming::make_point_range_source(points, points.parameters(), 0 /* check x order */);
     auto sink = NO::streaming::make_normal_writer(points, points.parameters());
-    NO::Streaming_options options;
-    options.presorted_axis = NO::Presorted_axis::X;
-    const NO::Streaming_result result = NO::streaming_orient_normals(source, sink, options);
+    const NO::Streaming_result result =
+      NO::streaming_orient_normals(source, sink, NO::parameters::presorted_axis(NO::Presorted_axis::X));
 
     std::cout << result.number_of_points << " points, " << result.number_of_segments << " segments, "
               << result.number_of_components << " component(s), peak window " << result.peak_window

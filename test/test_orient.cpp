@@ -574,7 +574,7 @@ TEST(Streaming_sweep, GivesExactlyTheInCoreGraphWithBoundedWindow)
     }
     NO::Neighbor_graph g;
     const NO::Neighbor_graph_report gr = NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(
-      pts, nrm, 12, 0.0, NO::Hoppe_criterion(), g, NO::internal::Progress(std::function<bool(double)>()));
+      pts, nrm, 12, 0.0, NO::Hoppe_criterion(), g, NO::Progress_reporter());
     std::vector<std::pair<std::uint64_t, std::uint64_t>> expected;
     for (auto e : boost::make_iterator_range(edges(g))) {
       const std::uint64_t a = source(e, g), b = target(e, g);
@@ -651,7 +651,12 @@ TEST(Streaming_sweep, RefusesUnsortedInput)
 
 #include <Normal_orientation/streaming_orient_normals.h>
 
+#include "Streaming_test_options.h"
+
 namespace {
+
+using NO::test::Stream_options;
+using NO::test::params;
 
 struct Rewindable_source
 {
@@ -704,11 +709,11 @@ TEST(Streaming_orient_normals, AgreesWithInCoreAndFacesOutward)
     Rewindable_source src{as_records(input)};
     std::vector<NO::Point_record> out;
     auto sink = [&](const NO::Point_record& r) { out.push_back(r); };
-    NO::Streaming_options options;
+    Stream_options options;
     options.radius = ic.neighbor_radius; // the same graph as in core
     options.batch_size = 2000;
-    options.sort.memory_budget = 200000 * sizeof(NO::Point_record) / 50; // several runs
-    const NO::Streaming_result sr = NO::streaming_orient_normals(src, sink, options);
+    options.sort_memory = 200000 * sizeof(NO::Point_record) / 50; // several runs
+    const NO::Streaming_result sr = NO::streaming_orient_normals(src, sink, params(options));
     ASSERT_EQ(out.size(), input.size());
     EXPECT_EQ(sr.number_of_points, input.size());
     EXPECT_EQ(sr.number_of_edges, ic.number_of_edges);
@@ -735,8 +740,8 @@ TEST(Streaming_orient_normals, AgreesWithInCoreAndFacesOutward)
     Rewindable_source again{as_records(input)};
     std::vector<NO::Point_record> out2;
     auto sink2 = [&](const NO::Point_record& r) { out2.push_back(r); };
-    NO::Streaming_options estimated;
-    const NO::Streaming_result er = NO::streaming_orient_normals(again, sink2, estimated);
+    Stream_options estimated;
+    const NO::Streaming_result er = NO::streaming_orient_normals(again, sink2, params(estimated));
     EXPECT_TRUE(er.radius_estimated);
     EXPECT_NEAR(er.neighbor_radius / ic.neighbor_radius, 1.0, 0.25);
     std::size_t wrong2 = 0;

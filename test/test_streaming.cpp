@@ -15,6 +15,7 @@
 #include <Normal_orientation/streaming/external_sort.h>
 #include <Normal_orientation/streaming_orient_normals.h>
 
+#include "Streaming_test_options.h"
 #include "Test_directory.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -50,7 +51,7 @@ namespace {
 
 namespace fs = std::filesystem;
 namespace ns = Normal_orientation::streaming;
-using ns::Point_record;
+using Normal_orientation::Point_record;
 using ns::Sweep_frame;
 using Vec = std::array<double, 3>;
 
@@ -690,6 +691,8 @@ TEST(Determinism, SameInputSameOutput)
 // ---------------------------------------------------------------------------
 
 namespace NO = Normal_orientation;
+using NO::test::Stream_options;
+using NO::test::params;
 
 /// a record with the given position, normal and index
 Point_record oriented_record(const Vec& p, const Vec& n, std::uint64_t index)
@@ -746,21 +749,20 @@ std::vector<Point_record> sorted_by(std::vector<Point_record> records, int axis)
 }
 
 /// options whose temporary files all go to `directory`
-NO::Streaming_options streaming_options_in(const std::string& directory)
+Stream_options streaming_options_in(const std::string& directory)
 {
-  NO::Streaming_options options;
+  Stream_options options;
   options.temporary_directory = directory;
-  options.sort.temporary_directory = directory;
   return options;
 }
 
 /// runs streaming_orient_normals on `source`, collecting the sink's records
-NO::Streaming_result stream(Vector_source& source, const NO::Streaming_options& options,
+NO::Streaming_result stream(Vector_source& source, const Stream_options& options,
                             std::vector<Point_record>& out)
 {
   out.clear();
   auto sink = [&out](const Point_record& r) { out.push_back(r); };
-  return NO::streaming_orient_normals(source, sink, options);
+  return NO::streaming_orient_normals(source, sink, params(options));
 }
 
 /// writes `records` to the point file `path`
@@ -807,9 +809,9 @@ TEST(Streaming_presorted, SameOrientationAsTheSortedPath)
   std::vector<Point_record> shuffled = cloud.records;
   std::shuffle(shuffled.begin(), shuffled.end(), rng);
   Vector_source source(shuffled);
-  NO::Streaming_options options = streaming_options_in(directory.path());
+  Stream_options options = streaming_options_in(directory.path());
   options.batch_size = 2000;
-  options.sort.memory_budget = 5000 * ns::External_sort_options::bytes_per_record; // several runs
+  options.sort_memory = 5000 * ns::External_sort_options::bytes_per_record; // several runs
   std::vector<Point_record> reference;
   const NO::Streaming_result ref = stream(source, options, reference);
   ASSERT_EQ(reference.size(), n);
@@ -826,9 +828,9 @@ TEST(Streaming_presorted, SameOrientationAsTheSortedPath)
   for (int axis = 0; axis < 3; ++axis) {
     SCOPED_TRACE(axis);
     Vector_source presorted(sorted_by(cloud.records, axis));
-    NO::Streaming_options po = options;
+    Stream_options po = options;
     po.presorted_axis = axes[axis];
-    po.sort.memory_budget = 16 * ns::External_sort_options::bytes_per_record; // would make runs: it must not sort
+    po.sort_memory = 16 * ns::External_sort_options::bytes_per_record; // would make runs: it must not sort
     std::size_t most_files = 0;
     presorted.on_read = [&](std::size_t) { most_files = std::max(most_files, directory.count()); };
     std::vector<Point_record> out;
@@ -867,13 +869,13 @@ TEST(Streaming_presorted, UnsortedInputFailsEarlyWithAClearError)
   cloud.ellipsoid(5000, Vec{{0., 0., 0.}}, 3., 1., 1., rng);
   std::vector<Point_record> records = sorted_by(cloud.records, 0);
   std::swap(records[1500], records[1700]);
-  NO::Streaming_options options = streaming_options_in(directory.path());
+  Stream_options options = streaming_options_in(directory.path());
   options.presorted_axis = NO::Presorted_axis::X;
   std::size_t sunk = 0;
   auto sink = [&sunk](const Point_record&) { ++sunk; };
   Vector_source source(records);
   try {
-    NO::streaming_orient_normals(source, sink, options);
+    NO::streaming_orient_normals(source, sink, params(options));
     FAIL() << "no error";
   } catch (const std::runtime_error& e) {
     const std::string what = e.what();
@@ -890,15 +892,15 @@ TEST(Streaming_presorted, UnsortedInputFailsEarlyWithAClearError)
   // from files: no output, no temporary file
   write_cloud(files.file("in.ply"), records);
   options.component_files.directory = files.file("components");
-  EXPECT_THROW(NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), options), std::runtime_error);
+  EXPECT_THROW(NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), params(options)), std::runtime_error);
   EXPECT_EQ(files.listing(), std::vector<std::string>{"in.ply"});
   EXPECT_EQ(directory.count(), 0u);
   // sorted along y, it is not sorted along x, but it is along y
   write_cloud(files.file("in_y.ply"), sorted_by(cloud.records, 1));
   options.component_files.directory.clear();
-  EXPECT_THROW(NO::streaming_orient_files(files.file("in_y.ply"), files.file("out.ply"), options), std::runtime_error);
+  EXPECT_THROW(NO::streaming_orient_files(files.file("in_y.ply"), files.file("out.ply"), params(options)), std::runtime_error);
   options.presorted_axis = NO::Presorted_axis::Y;
-  const NO::Streaming_result r = NO::streaming_orient_files(files.file("in_y.ply"), files.file("out.ply"), options);
+  const NO::Streaming_result r = NO::streaming_orient_files(files.file("in_y.ply"), files.file("out.ply"), params(options));
   EXPECT_EQ(r.number_of_points, records.size());
   EXPECT_EQ(read_cloud(files.file("out.ply")).size(), records.size());
   EXPECT_EQ(directory.count(), 0u);
@@ -923,11 +925,11 @@ TEST(Streaming_components, MinimumSizeDropsSmallComponentsFromEveryOutput)
   const Test_cloud cloud = two_bodies_and_dust(rng);
   const std::size_t n = cloud.records.size();
   write_cloud(files.file("in.ply"), cloud.records);
-  NO::Streaming_options options = streaming_options_in(directory.path());
+  Stream_options options = streaming_options_in(directory.path());
   options.radius = 0.3;
   options.minimum_component_size = 10;
   options.component_files.directory = files.file("parts/a"); // created, with its parent
-  const NO::Streaming_result r = NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), options);
+  const NO::Streaming_result r = NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), params(options));
   EXPECT_EQ(r.number_of_points, n);
   EXPECT_EQ(r.number_of_components, 8u);
   EXPECT_EQ(r.number_of_dropped_components, 6u);
@@ -962,13 +964,13 @@ TEST(Streaming_components, MinimumSizeDropsSmallComponentsFromEveryOutput)
   const std::string first = file_bytes(r.component_files[0]), second = file_bytes(r.component_files[1]);
   options.component_files.maximum_open_files = 1;
   options.component_files.directory = files.file("parts/b");
-  const NO::Streaming_result r1 = NO::streaming_orient_files(files.file("in.ply"), files.file("out1.ply"), options);
+  const NO::Streaming_result r1 = NO::streaming_orient_files(files.file("in.ply"), files.file("out1.ply"), params(options));
   ASSERT_EQ(r1.component_files.size(), 2u);
   EXPECT_EQ(file_bytes(r1.component_files[0]), first);
   EXPECT_EQ(file_bytes(r1.component_files[1]), second);
   EXPECT_EQ(file_bytes(files.file("out1.ply")), file_bytes(files.file("out.ply")));
   options.component_files.directory = files.file("parts/c");
-  const NO::Streaming_result rx = NO::streaming_orient_files(files.file("in.ply"), files.file("out.xyz"), options);
+  const NO::Streaming_result rx = NO::streaming_orient_files(files.file("in.ply"), files.file("out.xyz"), params(options));
   ASSERT_EQ(rx.component_files.size(), 2u);
   EXPECT_EQ(rx.component_files[1], files.file("parts/c/component_000001.xyz"));
   EXPECT_EQ(read_cloud(rx.component_files[1]).size(), 1500u);
@@ -978,7 +980,7 @@ TEST(Streaming_components, MinimumSizeDropsSmallComponentsFromEveryOutput)
   options.minimum_component_size = 0;
   options.component_files.maximum_open_files = 3;
   options.component_files.directory = files.file("parts/d");
-  const NO::Streaming_result r0 = NO::streaming_orient_files(files.file("in.ply"), files.file("out0.ply"), options);
+  const NO::Streaming_result r0 = NO::streaming_orient_files(files.file("in.ply"), files.file("out0.ply"), params(options));
   EXPECT_EQ(r0.number_of_dropped_components, 0u);
   EXPECT_EQ(r0.number_of_dropped_points, 0u);
   EXPECT_EQ(read_cloud(files.file("out0.ply")).size(), n);
@@ -1019,17 +1021,17 @@ TEST(Streaming_components, InputOrderCopyKeepsEveryPropertyAndTheOrder)
           << float(r.normal[1]) << ' ' << float(r.normal[2]) << ' ' << (r.index * 7) % 256 << '\n';
   }
   write_cloud(files.file("in.xyz"), read_cloud(files.file("in.ply")));
-  NO::Streaming_options options = streaming_options_in(directory.path());
+  Stream_options options = streaming_options_in(directory.path());
   options.radius = 0.3;
   options.minimum_component_size = 10;
   const NO::Streaming_result reference =
-    NO::streaming_orient_files(files.file("in.ply"), files.file("sweep.ply"), options);
+    NO::streaming_orient_files(files.file("in.ply"), files.file("sweep.ply"), params(options));
   const std::vector<Point_record> swept = read_cloud(files.file("sweep.ply"));
   ASSERT_EQ(swept.size(), n - 6);
 
   NO::IO::Transcode_report report;
   const NO::Streaming_result r = NO::streaming_orient_files_in_input_order<CGAL::Parallel_if_available_tag>(
-    files.file("in.ply"), files.file("out.ply"), options, NO::Hoppe_criterion(), NO::Qpbo_i_solver(), &report);
+    files.file("in.ply"), files.file("out.ply"), params(options), &report);
   EXPECT_EQ(r.number_of_points, n);
   EXPECT_EQ(r.number_of_dropped_points, 6u);
   EXPECT_EQ(r.number_of_flipped, reference.number_of_flipped);
@@ -1077,23 +1079,23 @@ TEST(Streaming_components, InputOrderCopyKeepsEveryPropertyAndTheOrder)
 
   // an .xyz input: an .xyz copy, with the same signs
   const NO::Streaming_result rx =
-    NO::streaming_orient_files_in_input_order(files.file("in.xyz"), files.file("out.xyz"), options);
+    NO::streaming_orient_files_in_input_order(files.file("in.xyz"), files.file("out.xyz"), params(options));
   EXPECT_EQ(rx.number_of_flipped, r.number_of_flipped);
   EXPECT_EQ(sorted_points(read_cloud(files.file("out.xyz"))), sorted_points(out));
   // another format than the input's: refused before any work, nothing written
-  EXPECT_THROW(NO::streaming_orient_files_in_input_order(files.file("in.ply"), files.file("out2.xyz"), options),
+  EXPECT_THROW(NO::streaming_orient_files_in_input_order(files.file("in.ply"), files.file("out2.xyz"), params(options)),
                NO::IO::Io_error);
-  EXPECT_THROW(NO::streaming_orient_files_in_input_order(files.file("in.xyz"), files.file("out2.ply"), options),
+  EXPECT_THROW(NO::streaming_orient_files_in_input_order(files.file("in.xyz"), files.file("out2.ply"), params(options)),
                NO::IO::Io_error);
   EXPECT_FALSE(fs::exists(files.file("out2.xyz")));
   EXPECT_FALSE(fs::exists(files.file("out2.ply")));
   // a cancellation during the copy: no output, nothing left
-  NO::Streaming_options cancel = options;
-  cancel.callback = [n](const NO::Streaming_progress& p) { // the copy counts bytes, not points
-    return !(p.stage == NO::Streaming_stage::OUTPUT && p.total != n && p.done > 0);
+  Stream_options cancel = options;
+  cancel.callback = [n](const NO::Progress_info& p) { // the copy counts bytes, not points
+    return !(p.stage == NO::Stage::OUTPUT && p.total != n && p.done > 0);
   };
-  EXPECT_THROW(NO::streaming_orient_files_in_input_order(files.file("in.ply"), files.file("out3.ply"), cancel),
-               NO::Interrupted);
+  EXPECT_TRUE(
+    NO::streaming_orient_files_in_input_order(files.file("in.ply"), files.file("out3.ply"), params(cancel)).interrupted);
   EXPECT_FALSE(fs::exists(files.file("out3.ply")));
   EXPECT_EQ(directory.count(), 0u);
   std::size_t in_files = 0;
@@ -1113,14 +1115,14 @@ TEST(Streaming_components, ManyComponentsWithFewOpenFiles)
   std::shuffle(cloud.records.begin(), cloud.records.end(), rng);
   const std::size_t n = cloud.records.size();
   Vector_source source(cloud.records);
-  NO::Streaming_options options = streaming_options_in(directory.path());
+  Stream_options options = streaming_options_in(directory.path());
   options.radius = 0.3;
   options.batch_size = 100;
   options.component_files.directory = parts.path();
   options.component_files.maximum_open_files = 3; // 14 groups of 3, in 5 rounds
   std::size_t most_open = 0, most_temporary = 0;
-  options.callback = [&](const NO::Streaming_progress& p) {
-    if (p.stage == NO::Streaming_stage::COMPONENTS) {
+  options.callback = [&](const NO::Progress_info& p) {
+    if (p.stage == NO::Stage::COMPONENTS) {
       std::size_t open = 0;
       for (const std::string& f : parts.listing())
         open += f.find(".tmp.") != std::string::npos ? 1 : 0;
@@ -1169,11 +1171,11 @@ TEST(Streaming_progress, ReportsEveryStageInOrderAndCancels)
   std::mt19937_64 rng(21);
   Test_cloud cloud = two_bodies_and_dust(rng);
   const std::size_t n = cloud.records.size();
-  NO::Streaming_options options = streaming_options_in(directory.path());
+  Stream_options options = streaming_options_in(directory.path());
   options.batch_size = 300;
-  options.sort.memory_budget = 1000 * ns::External_sort_options::bytes_per_record;
-  std::vector<NO::Streaming_progress> log;
-  options.callback = [&log](const NO::Streaming_progress& p) {
+  options.sort_memory = 1000 * ns::External_sort_options::bytes_per_record;
+  std::vector<NO::Progress_info> log;
+  options.callback = [&log](const NO::Progress_info& p) {
     log.push_back(p);
     return true;
   };
@@ -1182,90 +1184,90 @@ TEST(Streaming_progress, ReportsEveryStageInOrderAndCancels)
     Vector_source source(cloud.records);
     stream(source, options, out);
   }
-  const NO::Streaming_stage order[] = {NO::Streaming_stage::SCAN,   NO::Streaming_stage::RADIUS,
-                                       NO::Streaming_stage::SORT,   NO::Streaming_stage::SWEEP,
-                                       NO::Streaming_stage::SOLVE,  NO::Streaming_stage::REFINE,
-                                       NO::Streaming_stage::SIGN,   NO::Streaming_stage::OUTPUT};
-  auto check_log = [&](const std::vector<NO::Streaming_stage>& expected) {
-    std::vector<NO::Streaming_stage> stages;
+  const NO::Stage order[] = {NO::Stage::SCAN,   NO::Stage::RADIUS,
+                                       NO::Stage::SORT,   NO::Stage::SWEEP,
+                                       NO::Stage::SOLVE,  NO::Stage::REFINE,
+                                       NO::Stage::SIGN,   NO::Stage::OUTPUT};
+  auto check_log = [&](const std::vector<NO::Stage>& expected) {
+    std::vector<NO::Stage> stages;
     for (std::size_t i = 0; i < log.size(); ++i) {
-      const NO::Streaming_progress& p = log[i];
-      EXPECT_GE(p.fraction(), 0.0);
-      EXPECT_LE(p.fraction(), 1.0);
+      const NO::Progress_info& p = log[i];
+      EXPECT_GE(p.stage_fraction(), 0.0);
+      EXPECT_LE(p.stage_fraction(), 1.0);
       if (stages.empty() || stages.back() != p.stage) {
         stages.push_back(p.stage);
-        EXPECT_EQ(p.done, 0u) << NO::streaming_stage_name(p.stage); // reported at its start
+        EXPECT_EQ(p.done, 0u) << NO::stage_name(p.stage); // reported at its start
       } else {
-        EXPECT_GE(p.done, log[i - 1].done) << NO::streaming_stage_name(p.stage);
+        EXPECT_GE(p.done, log[i - 1].done) << NO::stage_name(p.stage);
       }
       if (i + 1 == log.size() || log[i + 1].stage != p.stage) { // and at its end
-        EXPECT_EQ(p.done, p.total) << NO::streaming_stage_name(p.stage);
-        EXPECT_EQ(p.fraction(), 1.0) << NO::streaming_stage_name(p.stage);
+        EXPECT_EQ(p.done, p.total) << NO::stage_name(p.stage);
+        EXPECT_EQ(p.stage_fraction(), 1.0) << NO::stage_name(p.stage);
       }
     }
     EXPECT_EQ(stages, expected);
   };
-  check_log(std::vector<NO::Streaming_stage>(std::begin(order), std::end(order)));
+  check_log(std::vector<NO::Stage>(std::begin(order), std::end(order)));
   std::size_t sweep_reports = 0;
-  for (const NO::Streaming_progress& p : log)
-    if (p.stage == NO::Streaming_stage::SWEEP) {
+  for (const NO::Progress_info& p : log)
+    if (p.stage == NO::Stage::SWEEP) {
       ++sweep_reports;
       EXPECT_EQ(p.total, n);
     }
   EXPECT_GT(sweep_reports, 10u); // per batch
-  EXPECT_STREQ(NO::streaming_stage_name(NO::Streaming_stage::SWEEP), "sweep");
-  EXPECT_STREQ(NO::streaming_stage_name(NO::Streaming_stage::REFINE), "refine");
-  EXPECT_STREQ(NO::streaming_stage_name(NO::Streaming_stage::COMPONENTS), "components");
+  EXPECT_STREQ(NO::stage_name(NO::Stage::SWEEP), "sweep");
+  EXPECT_STREQ(NO::stage_name(NO::Stage::REFINE), "refine");
+  EXPECT_STREQ(NO::stage_name(NO::Stage::COMPONENTS), "components");
 
   // presorted, with a radius and component files: no sort, no radius stage
   log.clear();
   {
-    NO::Streaming_options po = options;
+    Stream_options po = options;
     po.presorted_axis = NO::Presorted_axis::X;
     po.radius = 0.3;
     po.component_files.directory = files.file("parts");
     Vector_source source(sorted_by(cloud.records, 0));
     stream(source, po, out);
   }
-  check_log({NO::Streaming_stage::SCAN, NO::Streaming_stage::SWEEP, NO::Streaming_stage::SOLVE,
-             NO::Streaming_stage::REFINE, NO::Streaming_stage::SIGN, NO::Streaming_stage::OUTPUT,
-             NO::Streaming_stage::COMPONENTS});
+  check_log({NO::Stage::SCAN, NO::Stage::SWEEP, NO::Stage::SOLVE,
+             NO::Stage::REFINE, NO::Stage::SIGN, NO::Stage::OUTPUT,
+             NO::Stage::COMPONENTS});
 
-  // cancelled half way through the sweep: Interrupted, nothing sunk, nothing left
+  // cancelled half way through the sweep: interrupted, nothing sunk, nothing left
   {
-    NO::Streaming_options co = options;
-    co.callback = [](const NO::Streaming_progress& p) {
-      return !(p.stage == NO::Streaming_stage::SWEEP && p.fraction() >= 0.5);
+    Stream_options co = options;
+    co.callback = [](const NO::Progress_info& p) {
+      return !(p.stage == NO::Stage::SWEEP && p.stage_fraction() >= 0.5);
     };
     Vector_source source(cloud.records);
-    EXPECT_THROW(stream(source, co, out), NO::Interrupted);
+    EXPECT_TRUE(stream(source, co, out).interrupted);
     EXPECT_TRUE(out.empty());
     EXPECT_EQ(directory.count(), 0u);
   }
   // cancelled during the sort
   {
-    NO::Streaming_options co = options;
-    co.callback = [](const NO::Streaming_progress& p) {
-      return !(p.stage == NO::Streaming_stage::SORT && p.fraction() >= 0.5);
+    Stream_options co = options;
+    co.callback = [](const NO::Progress_info& p) {
+      return !(p.stage == NO::Stage::SORT && p.stage_fraction() >= 0.5);
     };
     Vector_source source(cloud.records);
-    EXPECT_THROW(stream(source, co, out), NO::Interrupted);
+    EXPECT_TRUE(stream(source, co, out).interrupted);
     EXPECT_EQ(directory.count(), 0u);
   }
   // cancelled once a component file is written: no output, no component
   // file, not even the directory the run created, no temporary file
   {
     write_cloud(files.file("in.ply"), cloud.records);
-    NO::Streaming_options co = options;
+    Stream_options co = options;
     co.radius = 0.3;
     co.component_files.directory = files.file("cancelled");
     co.component_files.maximum_open_files = 1;
     bool seen_file = false;
-    co.callback = [&](const NO::Streaming_progress& p) {
+    co.callback = [&](const NO::Progress_info& p) {
       seen_file = seen_file || fs::exists(files.file("cancelled/component_000000.ply"));
-      return !(p.stage == NO::Streaming_stage::COMPONENTS && seen_file);
+      return !(p.stage == NO::Stage::COMPONENTS && seen_file);
     };
-    EXPECT_THROW(NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), co), NO::Interrupted);
+    EXPECT_TRUE(NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), params(co)).interrupted);
     EXPECT_TRUE(seen_file);
     EXPECT_EQ(files.listing(), (std::vector<std::string>{"in.ply", "parts"}));
     EXPECT_EQ(directory.count(), 0u);
@@ -1298,9 +1300,9 @@ TEST(Streaming_window, PeakDoesNotGrowWithTheLength)
     for (int which = 0; which < 2; ++which) {
       const Test_cloud& cloud = which == 0 ? short_cloud : long_cloud;
       Vector_source source(presorted ? sorted_by(cloud.records, 0) : cloud.records);
-      NO::Streaming_options options = streaming_options_in(directory.path());
+      Stream_options options = streaming_options_in(directory.path());
       options.batch_size = 1000; // the window is a slab of about 3r, plus a batch and a read
-      options.sort.memory_budget = 20000 * ns::External_sort_options::bytes_per_record;
+      options.sort_memory = 20000 * ns::External_sort_options::bytes_per_record;
       if (presorted)
         options.presorted_axis = NO::Presorted_axis::X;
       std::vector<Point_record> out;
@@ -1360,7 +1362,7 @@ TEST(Streaming_point_range, OrientsAUserRangeInPlaceAndChecksItsOrder)
 
   // the reference: the same records through a plain vector source
   Vector_source reference_source(sorted);
-  NO::Streaming_options options = streaming_options_in(directory.path());
+  Stream_options options = streaming_options_in(directory.path());
   options.presorted_axis = NO::Presorted_axis::X;
   std::vector<Point_record> reference;
   const NO::Streaming_result rr = stream(reference_source, options, reference);
@@ -1369,7 +1371,7 @@ TEST(Streaming_point_range, OrientsAUserRangeInPlaceAndChecksItsOrder)
   auto source = ns::make_point_range_source(points, np, 0);
   EXPECT_EQ(source.size(), points.size());
   auto sink = ns::make_normal_writer(points, np);
-  const NO::Streaming_result result = NO::streaming_orient_normals(source, sink, options);
+  const NO::Streaming_result result = NO::streaming_orient_normals(source, sink, params(options));
   EXPECT_EQ(result.number_of_points, points.size());
   EXPECT_EQ(result.number_of_edges, rr.number_of_edges);
   std::size_t wrong = 0, differ = 0, moved = 0;
@@ -1496,26 +1498,26 @@ TEST(Streaming_faults, DiskFullHalfWayLeavesNothing)
   write_cloud(files.file("in.ply"), cloud.records);
   const std::vector<std::string> before = tree(files.path());
 
-  NO::Streaming_options options = streaming_options_in(temporary.path());
+  Stream_options options = streaming_options_in(temporary.path());
   options.batch_size = 2000;                                       // progress per batch of the sweep
-  options.sort.memory_budget = 4000 * ns::External_sort_options::bytes_per_record; // 10 runs of 224 kB
+  options.sort_memory = 4000 * ns::External_sort_options::bytes_per_record; // 10 runs of 224 kB
   options.component_files.directory = files.file("parts");
   const struct
   {
-    NO::Streaming_stage stage;
+    NO::Stage stage;
     std::uint64_t at;   // the disk fills once the stage has done this much
     rlim_t bytes;       // files are limited to this size from then on
   } faults[] = {
-    {NO::Streaming_stage::SORT, n / 2, 100000},      // the next run cannot be written
-    {NO::Streaming_stage::SWEEP, n / 2, 100000},     // the record file (64 bytes a point) stops growing
-    {NO::Streaming_stage::OUTPUT, 0, 200000},        // the output (48 bytes a point) stops at 200 kB
-    {NO::Streaming_stage::COMPONENTS, 0, 200000},    // so does the first component file
+    {NO::Stage::SORT, n / 2, 100000},      // the next run cannot be written
+    {NO::Stage::SWEEP, n / 2, 100000},     // the record file (64 bytes a point) stops growing
+    {NO::Stage::OUTPUT, 0, 200000},        // the output (48 bytes a point) stops at 200 kB
+    {NO::Stage::COMPONENTS, 0, 200000},    // so does the first component file
   };
   for (const auto& fault : faults) {
-    SCOPED_TRACE(NO::streaming_stage_name(fault.stage));
+    SCOPED_TRACE(NO::stage_name(fault.stage));
     bool reached = false;
     std::size_t most_temporary_files = 0;
-    options.callback = [&](const NO::Streaming_progress& p) {
+    options.callback = [&](const NO::Progress_info& p) {
       most_temporary_files = std::max(most_temporary_files, temporary.count());
       if (p.stage == fault.stage && p.done >= fault.at && !limit.filled()) {
         reached = true;
@@ -1525,7 +1527,7 @@ TEST(Streaming_faults, DiskFullHalfWayLeavesNothing)
     };
     std::string message;
     try {
-      NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), options);
+      NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), params(options));
     } catch (const std::exception& e) {
       message = e.what();
     }
@@ -1542,7 +1544,7 @@ TEST(Streaming_faults, DiskFullHalfWayLeavesNothing)
 
   // the same run with room enough
   options.callback = nullptr;
-  const NO::Streaming_result r = NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), options);
+  const NO::Streaming_result r = NO::streaming_orient_files(files.file("in.ply"), files.file("out.ply"), params(options));
   EXPECT_EQ(r.number_of_points, n);
   EXPECT_EQ(r.number_of_components, 2u);
   EXPECT_EQ(read_cloud(files.file("out.ply")).size(), n);
@@ -1565,11 +1567,11 @@ TEST(Streaming_faults, RecordFileWriteFailureInTheSweep)
   cloud.ellipsoid(40000, Vec{{0., 0., 0.}}, 4., 1., 1., rng);
   const std::uint64_t n = cloud.records.size();
   Vector_source source(sorted_by(cloud.records, 0));
-  NO::Streaming_options options = streaming_options_in(temporary.path());
+  Stream_options options = streaming_options_in(temporary.path());
   options.presorted_axis = NO::Presorted_axis::X;
   options.batch_size = 1000;
-  options.callback = [&](const NO::Streaming_progress& p) {
-    if (p.stage == NO::Streaming_stage::SWEEP && p.done >= n / 2 && !limit.filled())
+  options.callback = [&](const NO::Progress_info& p) {
+    if (p.stage == NO::Stage::SWEEP && p.done >= n / 2 && !limit.filled())
       limit.fill(64 * 1024);
     return true;
   };
@@ -1639,7 +1641,7 @@ struct Window_graph
 /// one pass of `Relabelling_window` over `g` from `labels`; returns the labels
 /// and the segments that come out, and the report
 NO::streaming::internal::Relabelling_report window_pass(const Window_graph& g, const std::vector<NO::Label>& labels,
-                                                          ns::Segmenter* segmenter, std::vector<NO::Label>& out,
+                                                          NO::Segmenter* segmenter, std::vector<NO::Label>& out,
                                                           std::vector<std::uint32_t>& segments)
 {
   ns::internal::Relabelling_window pass(g.span, segmenter, true);
@@ -1725,8 +1727,8 @@ TEST(Streaming_refinement, OneRoundFlipsAPlantedWrongPatch)
   EXPECT_EQ(r.moves, 0u);
 
   // one round: moves, re-segmentation (segments of at most 1000 points), solve
-  ns::Segmentation_thresholds theta{0.5, 0.5, 1000};
-  ns::Segmenter segmenter(theta, false);
+  NO::Segmentation_thresholds theta{0.5, 0.5, 1000};
+  NO::Segmenter segmenter(theta, false);
   r = window_pass(g, labels, &segmenter, moved, segments);
   EXPECT_EQ(segmenter.point_energy(std::vector<NO::Label>(segmenter.number_of_segments(), NO::Label(1))), planted);
   double change = 0.0;
@@ -1778,7 +1780,7 @@ double in_core_energy(const std::vector<Point_record>& in, const std::vector<Poi
   }
   NO::Neighbor_graph graph;
   NO::build_neighbor_graph<CGAL::Sequential_tag, K>(points, normals, k, radius, NO::Hoppe_criterion(), graph,
-                                                    NO::internal::Progress());
+                                                    NO::Progress_reporter());
   std::vector<NO::Label> labels(in.size(), NO::Label(1));
   for (const Point_record& r : out) {
     const Point_record& a = in[position[r.index]];
@@ -1807,8 +1809,8 @@ TEST(Streaming_refinement, NeverRaisesTheEnergyAndReportsItExactly)
   for (const unsigned int rounds : {0u, 1u, 3u}) {
     SCOPED_TRACE(rounds);
     Vector_source source(cloud.records);
-    NO::Streaming_options options = streaming_options_in(directory.path());
-    options.refinement.rounds = rounds;
+    Stream_options options = streaming_options_in(directory.path());
+    options.refinement_rounds = rounds;
     options.radius = 0.12;
     options.batch_size = 3000;
     std::vector<Point_record> out;
@@ -1845,13 +1847,13 @@ TEST(Streaming_refinement, NeverRaisesTheEnergyAndReportsItExactly)
   // the same bytes with one thread (no prefetching) and another batch size
   {
     Vector_source source(cloud.records);
-    NO::Streaming_options options = streaming_options_in(directory.path());
-    options.refinement.rounds = 3;
+    Stream_options options = streaming_options_in(directory.path());
+    options.refinement_rounds = 3;
     options.radius = 0.12;
     options.batch_size = 700;
     std::vector<Point_record> out;
     auto sink = [&out](const Point_record& r) { out.push_back(r); };
-    NO::streaming_orient_normals<CGAL::Sequential_tag>(source, sink, options);
+    NO::streaming_orient_normals<CGAL::Sequential_tag>(source, sink, params(options));
     expect_identical(out, reference);
   }
   EXPECT_EQ(directory.count(), 0u);
@@ -1866,9 +1868,9 @@ TEST(Streaming_refinement, SkippedWhenNothingContradicts)
   Test_cloud cloud;
   cloud.ellipsoid(10000, Vec{{0., 0., 0.}}, 2., 1., 1., rng);
   std::vector<Point_record> with, without;
-  NO::Streaming_options options = streaming_options_in(directory.path());
-  std::vector<NO::Streaming_stage> stages;
-  options.callback = [&stages](const NO::Streaming_progress& p) {
+  Stream_options options = streaming_options_in(directory.path());
+  std::vector<NO::Stage> stages;
+  options.callback = [&stages](const NO::Progress_info& p) {
     if (stages.empty() || stages.back() != p.stage)
       stages.push_back(p.stage);
     return true;
@@ -1878,8 +1880,8 @@ TEST(Streaming_refinement, SkippedWhenNothingContradicts)
   EXPECT_EQ(r.energy_before_refinement, 0.0);
   EXPECT_EQ(r.energy_after_refinement, 0.0);
   EXPECT_EQ(r.refinement_moves, 0u);
-  EXPECT_NE(std::find(stages.begin(), stages.end(), NO::Streaming_stage::REFINE), stages.end());
-  options.refinement.rounds = 0;
+  EXPECT_NE(std::find(stages.begin(), stages.end(), NO::Stage::REFINE), stages.end());
+  options.refinement_rounds = 0;
   options.callback = nullptr;
   stream(source, options, without);
   expect_identical(with, without);
@@ -1896,17 +1898,17 @@ TEST(Streaming_refinement, FailuresAndCancellationLeaveNothing)
   std::mt19937_64 rng(53);
   const Test_cloud cloud = frustrated_cloud(40000, rng);
   const std::uint64_t n = cloud.records.size();
-  NO::Streaming_options options = streaming_options_in(temporary.path());
+  Stream_options options = streaming_options_in(temporary.path());
   options.radius = 0.12;
   options.batch_size = 2000;
   std::vector<Point_record> out;
   {
-    NO::Streaming_options co = options;
-    co.callback = [&](const NO::Streaming_progress& p) {
-      return !(p.stage == NO::Streaming_stage::REFINE && p.done >= n);
+    Stream_options co = options;
+    co.callback = [&](const NO::Progress_info& p) {
+      return !(p.stage == NO::Stage::REFINE && p.done >= n);
     };
     Vector_source source(cloud.records);
-    EXPECT_THROW(stream(source, co, out), NO::Interrupted);
+    EXPECT_TRUE(stream(source, co, out).interrupted);
     EXPECT_TRUE(out.empty());
     EXPECT_EQ(temporary.count(), 0u);
   }
@@ -1914,8 +1916,8 @@ TEST(Streaming_refinement, FailuresAndCancellationLeaveNothing)
   if (!limit.usable())
     GTEST_SKIP() << "RLIMIT_FSIZE cannot be lowered here";
   bool reached = false;
-  options.callback = [&](const NO::Streaming_progress& p) {
-    if (p.stage == NO::Streaming_stage::REFINE && p.done >= n / 2 && !limit.filled()) {
+  options.callback = [&](const NO::Progress_info& p) {
+    if (p.stage == NO::Stage::REFINE && p.done >= n / 2 && !limit.filled()) {
       reached = true;
       limit.fill(64 * 1024); // a label file holds 4 bytes a point
     }

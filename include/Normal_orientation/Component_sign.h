@@ -6,13 +6,16 @@
 /// \file Component_sign.h
 /// Component sign policies: the energy does not change when every label of
 /// a connected component flips, so after the solve a policy decides the
-/// sign of each component.
+/// sign of each component.  A policy is an accumulator that both drivers
+/// feed, point by point, in as many passes as it asks for: the in-core
+/// driver from its vectors (`component_signs()`), the streaming driver from
+/// its record file.  Each rule therefore exists once.
 
-#include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/Orientation_problem.h>
 
 #include <CGAL/number_utils.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -21,26 +24,34 @@
 namespace Normal_orientation {
 
 /// \ingroup PkgNormalOrientationSign
-/// What a component sign policy sees.  `normals[i] * labels[i]` is the
-/// current orientation of point i (normals are unit length, or zero).
-template <typename Kernel>
-struct Component_sign_input
+/// What a sign accumulator is told before the passes over the points.
+struct Component_sign_setup
 {
-  /// the positions
-  const std::vector<typename Kernel::Point_3>& points;
-  /// the input normals, normalised (zero where the input normal was zero)
-  const std::vector<typename Kernel::Vector_3>& normals;
-  /// the labels chosen by the solver (+1 / -1)
-  const std::vector<Label>& labels;
-  /// the component of every point, 0 ... number_of_components - 1
-  const std::vector<std::uint32_t>& component;
-  /// the number of components
-  std::size_t number_of_components;
+  /// the number of components, numbered 0 ... number_of_components - 1
+  std::size_t number_of_components = 0;
+  /// the number of points of each component (the points fed to every pass)
+  std::vector<std::uint64_t> component_size;
   /// the neighbour radius r of the graph
-  double radius;
-  /// when not null, `(*constrained)[i] != 0` marks a point whose input
-  /// normal is known to be correctly oriented (`point_is_constrained_map`)
-  const std::vector<char>* constrained;
+  double radius = 0.0;
+};
+
+/// \ingroup PkgNormalOrientationSign
+/// One point as a sign accumulator sees it, in every pass, in the same
+/// order each time.
+struct Component_sign_point
+{
+  /// its component
+  std::uint32_t component = 0;
+  /// its position
+  std::array<double, 3> position{{0.0, 0.0, 0.0}};
+  /// its current orientation: the unit input normal times `label` (zero
+  /// when the input normal is zero)
+  std::array<double, 3> normal{{0.0, 0.0, 0.0}};
+  /// the label the solver gave it: +1 keeps the input sign, -1 flips it
+  Label label = 1;
+  /// true when its input normal is known to be correctly oriented
+  /// (`point_is_constrained_map`)
+  bool constrained = false;
 };
 
 /// \ingroup PkgNormalOrientationSign
@@ -48,12 +59,24 @@ struct Component_sign_input
 /// \cgalModels `ComponentSignPolicy`
 struct Keep_component_sign
 {
-  /// returns, for each component, whether to flip it: never
-  template <typename Kernel>
-  std::vector<char> operator()(const Component_sign_input<Kernel>& in) const
+  /// the accumulator: needs no pass
+  class Accumulator
   {
-    return std::vector<char>(in.number_of_components, 0);
-  }
+  public:
+    /// an accumulator for `setup`
+    explicit Accumulator(const Component_sign_setup& setup) : m_components(setup.number_of_components) {}
+    /// the passes over the points needed: none
+    unsigned int number_of_passes() const { return 0; }
+    /// nothing to do
+    void add(unsigned int, const Component_sign_point&) {}
+    /// never flips
+    std::vector<char> decide() const { return std::vector<char>(m_components, 0); }
+
+  private:
+    std::size_t m_components;
+  };
+  /// begins the accumulation
+  Accumulator begin(const Component_sign_setup& setup) const { return Accumulator(setup); }
   /// the name used in reports
   static const char* name() { return "keep"; }
 };
@@ -94,116 +117,119 @@ struct Outward_component_sign
   /// the name used in reports
   static const char* name() { return "outward"; }
 
-  /// returns, for each component, whether to flip it
-  template <typename Kernel>
-  std::vector<char> operator()(const Component_sign_input<Kernel>& in) const
+  /// The accumulator: two passes when a component is large enough for the
+  /// witnesses (their extents, then their votes), else one.  Every sum is
+  /// accumulated in the order of the points: deterministic.
+  class Accumulator
   {
-    const std::size_t n = in.points.size(), nc = in.number_of_components;
-    std::vector<std::size_t> size(nc, 0);
-    for (std::size_t i = 0; i < n; ++i)
-      ++size[in.component[i]];
-    auto oriented = [&](std::size_t i, int d) {
-      return double(in.labels[i]) * CGAL::to_double(in.normals[i][d]);
-    };
-    auto coord = [&](std::size_t i, int d) { return CGAL::to_double(in.points[i][d]); };
-
-    // Large components: extremal witnesses along many directions.
-    const std::uint32_t none = ~std::uint32_t(0);
-    std::vector<std::uint32_t> large_id(nc, none);
-    std::size_t nl = 0;
-    for (std::size_t c = 0; c < nc; ++c)
-      if (size[c] >= minimum_size_for_directions)
-        large_id[c] = std::uint32_t(nl++);
-    const unsigned D = std::max(1u, number_of_directions);
-    std::vector<std::array<double, 3>> dir(D);
-    const double golden = M_PI * (3.0 - std::sqrt(5.0));
-    for (unsigned t = 0; t < D; ++t) { // Fibonacci sphere
-      const double z = 1.0 - (2.0 * t + 1.0) / double(D);
-      const double s = std::sqrt(std::max(0.0, 1.0 - z * z));
-      dir[t] = {s * std::cos(golden * t), s * std::sin(golden * t), z};
+  public:
+    /// an accumulator for `setup`, with the parameters of `rule`
+    Accumulator(const Outward_component_sign& rule, const Component_sign_setup& setup)
+      : m_band(rule.band), m_minimum_size(rule.minimum_size_for_directions), m_size(setup.component_size), m_stride(setup.number_of_components, 1),
+        m_seen(setup.number_of_components, 0), m_sum_p(setup.number_of_components, {0.0, 0.0, 0.0}),
+        m_sum_n(setup.number_of_components, {0.0, 0.0, 0.0}), m_sum_pn(setup.number_of_components, 0.0)
+    {
+      const std::size_t nc = setup.number_of_components;
+      m_size.resize(nc, 0);
+      const unsigned D = std::max(1u, rule.number_of_directions);
+      m_direction.resize(D);
+      const double golden = M_PI * (3.0 - std::sqrt(5.0));
+      for (unsigned d = 0; d < D; ++d) { // Fibonacci sphere
+        const double z = 1.0 - (2.0 * d + 1.0) / double(D);
+        const double sz = std::sqrt(std::max(0.0, 1.0 - z * z));
+        m_direction[d] = {sz * std::cos(golden * d), sz * std::sin(golden * d), z};
+      }
+      // A component of more than `maximum_voters` points votes with every
+      // s-th of its points, s = ceil(size / maximum_voters): the vote needs
+      // a dense sample of the extremal bands, and the drivers feed points
+      // in a spatially coherent order, so the subsample is spread evenly.
+      const std::uint64_t voters = std::max<std::uint64_t>(1, rule.maximum_voters);
+      for (std::size_t c = 0; c < nc; ++c) {
+        m_stride[c] = std::max<std::uint64_t>(1, (m_size[c] + voters - 1) / voters);
+        m_any_large = m_any_large || large(c);
+      }
+      if (m_any_large) {
+        m_hi.assign(nc * D, -HUGE_VAL);
+        m_lo.assign(nc * D, HUGE_VAL);
+        m_num.assign(nc * D, 0.0);
+        m_den.assign(nc * D, 0.0);
+      }
     }
-    // Flat copies of the points of large components (positions and
-    // current normals), so that the loops below stream through memory.
-    // A component of more than `maximum_voters` points votes with every
-    // s-th of its points, s = ceil(size / maximum_voters): the vote needs a
-    // dense sample of the extremal bands, not every point, and points
-    // arrive in a spatially coherent order (see `orient_normals()`), so the
-    // subsample is spread evenly.
-    std::vector<std::size_t> stride(nc, 1), seen(nc, 0);
-    for (std::size_t c = 0; c < nc; ++c)
-      stride[c] = std::max<std::size_t>(1, (size[c] + maximum_voters - 1) / std::max<std::size_t>(1, maximum_voters));
-    std::vector<std::uint32_t> cid;
-    std::vector<double> px, py, pz, nx, ny, nz;
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::uint32_t c = large_id[in.component[i]];
-      if (c == none)
-        continue;
-      if (seen[in.component[i]]++ % stride[in.component[i]] != 0)
-        continue;
-      cid.push_back(c);
-      px.push_back(coord(i, 0)); py.push_back(coord(i, 1)); pz.push_back(coord(i, 2));
-      nx.push_back(oriented(i, 0)); ny.push_back(oriented(i, 1)); nz.push_back(oriented(i, 2));
-    }
-    const std::size_t m = cid.size();
-    std::vector<double> hi(nl * D, -HUGE_VAL), lo(nl * D, HUGE_VAL), num(nl * D, 0.0), den(nl * D, 0.0);
-    if (nl > 0) {
-      // Each direction is handled by one task over all points, so every
-      // sum is accumulated in point order: deterministic for any thread
-      // count.
-      internal::parallel_chunks<CGAL::Parallel_if_available_tag>(D, [&](std::size_t b, std::size_t e) {
-        std::vector<double> proj(m);
-        for (std::size_t t = b; t < e; ++t) {
-          const double dx = dir[t][0], dy = dir[t][1], dz = dir[t][2];
-          for (std::size_t i = 0; i < m; ++i) {
-            const double p = px[i] * dx + py[i] * dy + pz[i] * dz;
-            proj[i] = p;
-            const std::size_t s = std::size_t(cid[i]) * D + t;
-            hi[s] = std::max(hi[s], p);
-            lo[s] = std::min(lo[s], p);
+    /// the passes over the points needed: 2 when a component is large
+    /// enough for the witnesses, else 1
+    unsigned int number_of_passes() const { return m_any_large ? 2 : 1; }
+    /// adds point `p` in pass `pass`
+    void add(unsigned int pass, const Component_sign_point& p)
+    {
+      const std::uint32_t c = p.component;
+      if (!large(c)) { // (p - centroid) . n summed, as sum p.n - centroid . sum n
+        if (pass == 0) {
+          for (int d = 0; d < 3; ++d) {
+            m_sum_p[c][d] += p.position[d];
+            m_sum_n[c][d] += p.normal[d];
           }
-          for (std::size_t i = 0; i < m; ++i) {
-            const std::size_t s = std::size_t(cid[i]) * D + t;
-            const double depth = band * (hi[s] - lo[s]);
-            const double w = depth > 0.0 ? 1.0 - (hi[s] - proj[i]) / depth : (proj[i] >= hi[s] ? 1.0 : 0.0);
-            if (w <= 0.0)
-              continue;
-            num[s] += w * (nx[i] * dx + ny[i] * dy + nz[i] * dz);
-            den[s] += w;
+          m_sum_pn[c] += p.position[0] * p.normal[0] + p.position[1] * p.normal[1] + p.position[2] * p.normal[2];
+        }
+        return;
+      }
+      if (pass != m_pass) { // a new pass: the subsample starts again
+        m_pass = pass;
+        std::fill(m_seen.begin(), m_seen.end(), 0);
+      }
+      if (m_seen[c]++ % m_stride[c] != 0)
+        return;
+      const std::size_t D = m_direction.size();
+      for (std::size_t d = 0; d < D; ++d) {
+        const std::array<double, 3>& u = m_direction[d];
+        const double proj = p.position[0] * u[0] + p.position[1] * u[1] + p.position[2] * u[2];
+        const std::size_t slot = std::size_t(c) * D + d;
+        if (pass == 0) {
+          m_hi[slot] = std::max(m_hi[slot], proj);
+          m_lo[slot] = std::min(m_lo[slot], proj);
+        } else {
+          const double depth = m_band * (m_hi[slot] - m_lo[slot]);
+          const double w = depth > 0.0 ? 1.0 - (m_hi[slot] - proj) / depth : (proj >= m_hi[slot] ? 1.0 : 0.0);
+          if (w > 0.0) {
+            m_num[slot] += w * (p.normal[0] * u[0] + p.normal[1] * u[1] + p.normal[2] * u[2]);
+            m_den[slot] += w;
           }
         }
-      }, 1);
+      }
     }
-    std::vector<double> vote(nc, 0.0);
-    for (std::size_t c = 0; c < nc; ++c)
-      if (large_id[c] != none)
-        for (unsigned t = 0; t < D; ++t) {
-          const std::size_t s = std::size_t(large_id[c]) * D + t;
-          if (den[s] > 0.0)
-            vote[c] += num[s] / den[s];
+    /// for each component, whether to flip it
+    std::vector<char> decide() const
+    {
+      const std::size_t nc = m_size.size(), D = m_direction.size();
+      std::vector<char> flip(nc, 0);
+      for (std::size_t c = 0; c < nc; ++c) {
+        double vote = 0.0;
+        if (large(c)) {
+          for (std::size_t d = 0; d < D; ++d)
+            if (m_den[c * D + d] > 0.0)
+              vote += m_num[c * D + d] / m_den[c * D + d];
+        } else if (m_size[c] > 0) {
+          const double m = double(m_size[c]);
+          vote = m_sum_pn[c] -
+                 (m_sum_p[c][0] * m_sum_n[c][0] + m_sum_p[c][1] * m_sum_n[c][1] + m_sum_p[c][2] * m_sum_n[c][2]) / m;
         }
-
-    // Small components: do normals point away from the centroid?
-    std::vector<std::array<double, 3>> centroid(nc, {0.0, 0.0, 0.0});
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t c = in.component[i];
-      if (large_id[c] != none)
-        continue;
-      for (int d = 0; d < 3; ++d)
-        centroid[c][d] += coord(i, d) / double(size[c]);
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-      const std::size_t c = in.component[i];
-      if (large_id[c] != none)
-        continue;
-      for (int d = 0; d < 3; ++d)
-        vote[c] += (coord(i, d) - centroid[c][d]) * oriented(i, d);
+        flip[c] = vote < 0.0 ? 1 : 0;
+      }
+      return flip;
     }
 
-    std::vector<char> flip(nc, 0);
-    for (std::size_t c = 0; c < nc; ++c)
-      flip[c] = vote[c] < 0.0 ? 1 : 0;
-    return flip;
-  }
+  private:
+    bool large(std::size_t c) const { return m_size[c] >= m_minimum_size; }
+
+    double m_band;
+    std::size_t m_minimum_size;
+    std::vector<std::uint64_t> m_size, m_stride, m_seen;
+    std::vector<std::array<double, 3>> m_direction, m_sum_p, m_sum_n;
+    std::vector<double> m_sum_pn, m_hi, m_lo, m_num, m_den;
+    bool m_any_large = false;
+    unsigned int m_pass = 0;
+  };
+  /// begins the accumulation
+  Accumulator begin(const Component_sign_setup& setup) const { return Accumulator(*this, setup); }
 };
 
 /// \ingroup PkgNormalOrientationSign
@@ -221,28 +247,46 @@ struct Viewpoint_component_sign
   /// the name used in reports
   static const char* name() { return "viewpoint"; }
 
-  /// returns, for each component, whether to flip it
-  template <typename Kernel>
-  std::vector<char> operator()(const Component_sign_input<Kernel>& in) const
+  /// the accumulator: one pass, the cosine between each normal and the
+  /// direction to the viewpoint summed per component
+  class Accumulator
   {
-    std::vector<double> vote(in.number_of_components, 0.0);
-    for (std::size_t i = 0; i < in.points.size(); ++i) {
+  public:
+    /// an accumulator for `setup` and the viewpoint `v`
+    Accumulator(const std::array<double, 3>& v, const Component_sign_setup& setup)
+      : m_viewpoint(v), m_vote(setup.number_of_components, 0.0)
+    {}
+    /// one pass
+    unsigned int number_of_passes() const { return 1; }
+    /// adds point `p`
+    void add(unsigned int, const Component_sign_point& p)
+    {
       double v[3], l2 = 0.0, dn = 0.0;
       for (int d = 0; d < 3; ++d) {
-        v[d] = viewpoint[d] - CGAL::to_double(in.points[i][d]);
+        v[d] = m_viewpoint[d] - p.position[d];
         l2 += v[d] * v[d];
       }
       if (!(l2 > 0.0))
-        continue;
+        return;
       for (int d = 0; d < 3; ++d)
-        dn += v[d] * double(in.labels[i]) * CGAL::to_double(in.normals[i][d]);
-      vote[in.component[i]] += dn / std::sqrt(l2);
+        dn += v[d] * p.normal[d];
+      m_vote[p.component] += dn / std::sqrt(l2);
     }
-    std::vector<char> flip(in.number_of_components, 0);
-    for (std::size_t c = 0; c < flip.size(); ++c)
-      flip[c] = vote[c] < 0.0 ? 1 : 0;
-    return flip;
-  }
+    /// for each component, whether to flip it
+    std::vector<char> decide() const
+    {
+      std::vector<char> flip(m_vote.size(), 0);
+      for (std::size_t c = 0; c < flip.size(); ++c)
+        flip[c] = m_vote[c] < 0.0 ? 1 : 0;
+      return flip;
+    }
+
+  private:
+    std::array<double, 3> m_viewpoint;
+    std::vector<double> m_vote;
+  };
+  /// begins the accumulation
+  Accumulator begin(const Component_sign_setup& setup) const { return Accumulator(viewpoint, setup); }
 };
 
 /// \ingroup PkgNormalOrientationSign
@@ -260,23 +304,101 @@ struct Constrained_component_sign
   /// the name used in reports
   static const char* name() { return "constrained"; }
 
-  /// returns, for each component, whether to flip it
-  template <typename Kernel>
-  std::vector<char> operator()(const Component_sign_input<Kernel>& in) const
+  /// the accumulator: the fallback's passes (at least one), and the labels
+  /// of the constrained points summed per component
+  class Accumulator
   {
-    std::vector<char> flip = fallback(in);
-    if (in.constrained == nullptr)
+  public:
+    /// an accumulator for `setup`, around the fallback's
+    Accumulator(const Fallback& fallback, const Component_sign_setup& setup)
+      : m_fallback(fallback.begin(setup)), m_agree(setup.number_of_components, 0)
+    {}
+    /// the fallback's passes, at least one
+    unsigned int number_of_passes() const { return std::max(1u, m_fallback.number_of_passes()); }
+    /// adds point `p` in pass `pass`
+    void add(unsigned int pass, const Component_sign_point& p)
+    {
+      if (pass < m_fallback.number_of_passes())
+        m_fallback.add(pass, p);
+      if (pass == 0 && p.constrained)
+        m_agree[p.component] += p.label;
+    }
+    /// for each component, whether to flip it
+    std::vector<char> decide() const
+    {
+      std::vector<char> flip = m_fallback.decide();
+      for (std::size_t c = 0; c < flip.size(); ++c)
+        if (m_agree[c] != 0)
+          flip[c] = m_agree[c] < 0 ? 1 : 0;
       return flip;
-    std::vector<long long> agree(in.number_of_components, 0);
-    for (std::size_t i = 0; i < in.points.size(); ++i)
-      if ((*in.constrained)[i])
-        agree[in.component[i]] += in.labels[i];
-    for (std::size_t c = 0; c < flip.size(); ++c)
-      if (agree[c] != 0)
-        flip[c] = agree[c] < 0 ? 1 : 0;
-    return flip;
-  }
+    }
+
+  private:
+    typename Fallback::Accumulator m_fallback;
+    std::vector<long long> m_agree;
+  };
+  /// begins the accumulation
+  Accumulator begin(const Component_sign_setup& setup) const { return Accumulator(fallback, setup); }
 };
+
+/// \ingroup PkgNormalOrientationSign
+/// The points of an in-core run, as `component_signs()` reads them.
+/// `normals[i] * labels[i]` is the current orientation of point i.
+template <typename Kernel>
+struct Component_sign_input
+{
+  /// the positions
+  const std::vector<typename Kernel::Point_3>& points;
+  /// the input normals, normalised (zero where the input normal was zero)
+  const std::vector<typename Kernel::Vector_3>& normals;
+  /// the labels chosen by the solver (+1 / -1)
+  const std::vector<Label>& labels;
+  /// the component of every point, 0 ... number_of_components - 1
+  const std::vector<std::uint32_t>& component;
+  /// the number of components
+  std::size_t number_of_components;
+  /// the neighbour radius r of the graph
+  double radius;
+  /// when not null, `(*constrained)[i] != 0` marks a point whose input
+  /// normal is known to be correctly oriented (`point_is_constrained_map`)
+  const std::vector<char>* constrained;
+};
+
+/// \ingroup PkgNormalOrientationSign
+/// Runs the sign policy `policy` over in-core points: feeds its
+/// accumulator every point, in index order, in each of its passes, and
+/// returns its decision (the in-core driver's sign stage; it also serves
+/// any graph of the user's, as in the example `orient_mesh_graph.cpp`).
+/// \tparam ComponentSignPolicy a model of `ComponentSignPolicy`
+/// \param policy the policy
+/// \param in the points, their normals, labels and components
+/// \return for each component, whether to flip it (non-zero)
+template <typename ComponentSignPolicy, typename Kernel>
+std::vector<char> component_signs(const ComponentSignPolicy& policy, const Component_sign_input<Kernel>& in)
+{
+  const std::size_t n = in.points.size();
+  Component_sign_setup setup;
+  setup.number_of_components = in.number_of_components;
+  setup.radius = in.radius;
+  setup.component_size.assign(in.number_of_components, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    ++setup.component_size[in.component[i]];
+  auto accumulator = policy.begin(setup);
+  const unsigned int passes = accumulator.number_of_passes();
+  Component_sign_point p;
+  for (unsigned int pass = 0; pass < passes; ++pass)
+    for (std::size_t i = 0; i < n; ++i) {
+      p.component = in.component[i];
+      p.label = in.labels[i];
+      p.constrained = in.constrained != nullptr && (*in.constrained)[i] != 0;
+      for (int d = 0; d < 3; ++d) {
+        p.position[d] = CGAL::to_double(in.points[i][d]);
+        p.normal[d] = double(in.labels[i]) * CGAL::to_double(in.normals[i][d]);
+      }
+      accumulator.add(pass, p);
+    }
+  return accumulator.decide();
+}
 
 } // namespace Normal_orientation
 

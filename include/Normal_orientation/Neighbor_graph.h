@@ -7,7 +7,8 @@
 /// The symmetric, radius-truncated k-nearest-neighbour graph of the paper
 /// (sec. 3), with the edge weights w_ij = phi(i, j) * omega(p_i, p_j).
 
-#include <Normal_orientation/internal/Progress.h>
+#include <Normal_orientation/Progress.h>
+#include <Normal_orientation/internal/Parallel.h>
 
 #include <CGAL/Kd_tree.h>
 #include <CGAL/Orthogonal_k_neighbor_search.h>
@@ -19,12 +20,6 @@
 
 #include <boost/graph/compressed_sparse_row_graph.hpp>
 #include <boost/iterator/counting_iterator.hpp>
-
-#ifdef CGAL_LINKED_WITH_TBB
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
-#endif
 
 #include <algorithm>
 #include <chrono>
@@ -82,6 +77,9 @@ struct Neighbor_graph_report
 /// close sheets of noisy thin parts more often, k = 10 left noisy regions
 /// badly connected.
 constexpr unsigned int default_number_of_neighbors = 12;
+/// \ingroup PkgNormalOrientationGraph
+/// the largest k that the drivers accept
+constexpr unsigned int maximum_number_of_neighbors = 100000;
 
 /// \ingroup PkgNormalOrientationGraph
 /// The rule used when no radius is given: r = `default_radius_factor` times
@@ -100,85 +98,32 @@ constexpr double default_radius_factor = 4.0;
 /// the percentile of the k-th neighbour distance used by the radius rule
 constexpr double default_radius_percentile = 0.9;
 
+/// \ingroup PkgNormalOrientationGraph
+/// The radius rule of both drivers: `default_radius_factor` times the
+/// `default_radius_percentile` quantile of the k-th neighbour distances,
+/// times `density_scale` (1 when the distances are those of every point;
+/// sqrt(sample size / n) for a uniform sample of a surface of n points,
+/// whose spacing is that much larger).  1 when that is not a finite number
+/// > 0 (every point with k coincident neighbours, or no distance at all).
+/// \param kth_squared_distances the squared k-th neighbour distances,
+///        reordered by the call
+/// \param density_scale the factor above
+/// \return r
+inline double estimate_neighbor_radius(std::vector<float>& kth_squared_distances, double density_scale)
+{
+  std::vector<float>& kth = kth_squared_distances;
+  if (kth.empty())
+    return 1.0;
+  const auto q =
+    kth.begin() + std::ptrdiff_t(std::min(kth.size() - 1, std::size_t(default_radius_percentile * double(kth.size()))));
+  std::nth_element(kth.begin(), q, kth.end());
+  const double radius = default_radius_factor * std::sqrt(double(*q)) * density_scale;
+  return radius > 0.0 && std::isfinite(radius) ? radius : 1.0;
+}
+
 /// \cond SKIP_IN_MANUAL
 namespace internal {
 
-/// Runs `f(begin, end)` over [0, n) in chunks, in parallel when
-/// `ConcurrencyTag` is `CGAL::Parallel_tag` and TBB is linked.
-template <typename ConcurrencyTag, typename F>
-void parallel_chunks(std::size_t n, const F& f, std::size_t grain = 1024)
-{
-#ifdef CGAL_LINKED_WITH_TBB
-  if (std::is_convertible<ConcurrencyTag, CGAL::Parallel_tag>::value) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain),
-                      [&](const tbb::blocked_range<std::size_t>& r) { f(r.begin(), r.end()); });
-    return;
-  }
-#endif
-  (void)grain;
-  f(std::size_t(0), n);
-}
-
-/// Sorts `v` with `less` (in parallel with TBB); the result is the same for
-/// any thread count when `less` is a strict total order.
-template <typename ConcurrencyTag, typename T, typename Less>
-void parallel_sort(std::vector<T>& v, Less less)
-{
-#ifdef CGAL_LINKED_WITH_TBB
-  if (std::is_convertible<ConcurrencyTag, CGAL::Parallel_tag>::value) {
-    tbb::parallel_sort(v.begin(), v.end(), less);
-    return;
-  }
-#endif
-  std::sort(v.begin(), v.end(), less);
-}
-
-/// spreads the low 21 bits of x to every third bit
-inline std::uint64_t spread_bits_3(std::uint64_t x)
-{
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffULL;
-  x = (x | x << 16) & 0x1f0000ff0000ffULL;
-  x = (x | x << 8) & 0x100f00f00f00f00fULL;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
-  x = (x | x << 2) & 0x1249249249249249ULL;
-  return x;
-}
-
-/// Returns the indices 0..n-1 in Morton (Z-curve) order of the points, ties
-/// broken by index: queries made in this order hit the kd-tree's caches.
-template <typename ConcurrencyTag, typename Point>
-std::vector<std::uint32_t> morton_order(const std::vector<Point>& points)
-{
-  const std::size_t n = points.size();
-  double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
-                  std::numeric_limits<double>::max()};
-  double hi[3] = {-lo[0], -lo[1], -lo[2]};
-  for (const Point& p : points)
-    for (int d = 0; d < 3; ++d) {
-      const double c = CGAL::to_double(p[d]);
-      lo[d] = std::min(lo[d], c);
-      hi[d] = std::max(hi[d], c);
-    }
-  double extent = 0.0;
-  for (int d = 0; d < 3; ++d)
-    extent = std::max(extent, hi[d] - lo[d]);
-  const double scale = extent > 0.0 ? double((1u << 21) - 1) / extent : 0.0;
-  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
-  parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) {
-      std::uint64_t code = 0;
-      for (int d = 0; d < 3; ++d)
-        code |= spread_bits_3(std::uint64_t((CGAL::to_double(points[i][d]) - lo[d]) * scale)) << d;
-      keyed[i] = {code, std::uint32_t(i)};
-    }
-  });
-  parallel_sort<ConcurrencyTag>(keyed, std::less<std::pair<std::uint64_t, std::uint32_t>>());
-  std::vector<std::uint32_t> order(n);
-  for (std::size_t i = 0; i < n; ++i)
-    order[i] = keyed[i].second;
-  return order;
-}
 
 /// The k nearest neighbours of every point (itself excluded), as flat
 /// arrays: neighbors[i*k + t] and squared distances sq_dist[i*k + t],
@@ -248,7 +193,7 @@ struct Knn_tree_types
 template <typename ConcurrencyTag, typename Kernel>
 void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, unsigned int k,
                          std::vector<std::uint32_t>& neighbors, std::vector<float>& sq_dist,
-                         const Progress& progress, double progress_begin, double progress_end)
+                         const Progress_reporter& progress, double progress_begin, double progress_end)
 {
   typedef Knn_tree_types<Kernel> Types;
   typedef typename Types::Point_pmap Point_pmap;
@@ -311,15 +256,16 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
 /// \param criterion a model of `FlipCriterion`
 /// \param graph receives the graph
 /// \param progress receives progress in [0, 1] and may interrupt the run
-///        (`internal::Progress()` reports nothing; `internal::Progress(callback)`
-///        calls a `std::function<bool(double)>`, whose `false` throws `Interrupted`)
+///        (`Progress_reporter()` reports nothing; a reporter whose callback
+///        returns `false` throws `Interrupted`)
 /// \pre points and normals are finite (checked by `orient_normals()`)
 /// \return what was measured and decided: the k and r used, the number of edges, the times
 template <typename ConcurrencyTag, typename Kernel, typename FlipCriterion>
 Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Point_3>& points,
                                            const std::vector<typename Kernel::Vector_3>& normals,
                                            unsigned int k, double radius, const FlipCriterion& criterion,
-                                           Neighbor_graph& graph, const internal::Progress& progress)
+                                           Neighbor_graph& graph,
+                                           const Progress_reporter& progress = Progress_reporter())
 {
   if (points.size() != normals.size())
     throw std::invalid_argument("build_neighbor_graph: points and normals differ in size");
@@ -348,12 +294,8 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
     for (std::size_t i = 0; i < n; ++i)
       kth[i] = d2[i * k + (k - 1)];
     if (radius == 0.0) {
-      auto q = kth.begin() + std::ptrdiff_t(std::min(n - 1, std::size_t(default_radius_percentile * double(n))));
-      std::nth_element(kth.begin(), q, kth.end());
-      radius = default_radius_factor * std::sqrt(double(*q));
+      radius = estimate_neighbor_radius(kth, 1.0);
       report.radius_estimated = true;
-      if (!(radius > 0.0)) // every point has k coincident neighbours
-        radius = 1.0;
     }
   } else if (radius == 0.0) {
     radius = 1.0;

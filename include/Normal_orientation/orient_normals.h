@@ -10,7 +10,9 @@
 #include <Normal_orientation/Flip_criteria.h>
 #include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/Orientation_problem.h>
-#include <Normal_orientation/internal/Progress.h>
+#include <Normal_orientation/Orientation_result.h>
+#include <Normal_orientation/Progress.h>
+#include <Normal_orientation/internal/Settings.h>
 #include <Normal_orientation/parameters.h>
 #include <Normal_orientation/solvers/Mst_solver.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
@@ -37,91 +39,6 @@
 
 namespace Normal_orientation {
 
-/// \ingroup PkgNormalOrientationRef
-/// Wall-clock seconds of each stage of `orient_normals()`.
-struct Stage_seconds
-{
-  double input = 0.0;     ///< copying, checking and spatially sorting the input
-  double neighbors = 0.0; ///< kd-tree and k-nearest-neighbour queries
-  double graph = 0.0;     ///< edge weights and graph assembly
-  double solve = 0.0;     ///< the solver
-  double sign = 0.0;      ///< components and their global signs
-  double output = 0.0;    ///< writing the normals back
-  double total = 0.0;     ///< the whole call
-};
-
-/// \ingroup PkgNormalOrientationRef
-/// What `orient_normals()` did.
-struct Orientation_result
-{
-  std::size_t number_of_points = 0;     ///< points in the input
-  std::size_t number_of_edges = 0;      ///< edges of the neighbour graph
-  std::size_t number_of_components = 0; ///< connected components (each got its own global sign)
-  std::size_t number_of_flipped = 0;    ///< normals whose sign was changed
-  std::size_t number_of_zero_normals = 0; ///< zero normals (left as they were)
-  unsigned int number_of_neighbors = 0; ///< k used
-  double neighbor_radius = 0.0;         ///< r used
-  bool radius_estimated = false;        ///< true when r was estimated from the data
-  double energy_before = 0.0;           ///< energy (eq. 3) of the input orientation
-  double energy_after = 0.0;            ///< energy of the output orientation
-  std::size_t frustrated_edges = 0;     ///< edges whose wish the output does not meet
-  std::size_t number_of_segments = 0;   ///< vertices of the segment graph the solver reduced to (0: none)
-  std::size_t number_of_unary_terms = 0; ///< points with a constraint or a non-zero prior
-  std::string criterion;                ///< the flip criterion's name
-  std::string solver;                   ///< the solver's name
-  std::string component_sign;           ///< the component sign policy's name
-  bool interrupted = false;             ///< true when the callback stopped the run (nothing was written)
-  Stage_seconds seconds;                ///< time per stage
-};
-
-/// \cond SKIP_IN_MANUAL
-namespace internal {
-
-template <typename T, typename = void>
-struct Has_name : std::false_type {};
-template <typename T>
-struct Has_name<T, std::void_t<decltype(T::name())>> : std::true_type {};
-
-/// true when `Solver` has the 4-argument solve(graph, weight, unary, labels)
-template <typename Solver, typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap, typename = void>
-struct Accepts_unary : std::false_type {};
-template <typename Solver, typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
-struct Accepts_unary<Solver, Graph, WeightMap, UnaryMap, LabelMap,
-                     std::void_t<decltype(std::declval<const Solver&>().solve(
-                       std::declval<const Graph&>(), std::declval<WeightMap>(), std::declval<UnaryMap>(),
-                       std::declval<LabelMap>()))>> : std::true_type {};
-
-template <typename T>
-std::string name_of(const T&)
-{
-  if constexpr (Has_name<T>::value)
-    return T::name();
-  else
-    return "user";
-}
-
-inline double seconds_since(std::chrono::steady_clock::time_point t)
-{
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
-
-/// runs `f` with at most `threads` threads (0: all)
-template <typename F>
-void run_with_threads(int threads, const F& f)
-{
-#ifdef CGAL_LINKED_WITH_TBB
-  if (threads > 0) {
-    tbb::task_arena arena(threads);
-    arena.execute(f);
-    return;
-  }
-#endif
-  (void)threads;
-  f();
-}
-
-} // namespace internal
-/// \endcond
 
 /// \ingroup PkgNormalOrientationRef
 /// Orients the normals of `points` consistently and, by default, outward.
@@ -204,8 +121,10 @@ void run_with_threads(int threads, const F& f)
 ///     \cgalParamDefault{no prior}
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{callback}
-///     \cgalParamDescription{called with the progress in [0, 1], from the calling thread; returning `false` interrupts the run}
-///     \cgalParamType{`std::function<bool(double)>`}
+///     \cgalParamDescription{called with the progress, from the calling thread; returning `false` interrupts the
+///       run (see `Progress.h`)}
+///     \cgalParamType{`std::function<bool(double)>` (the fraction of the run done, in [0, 1]) or a callable as
+///       `bool(const Progress_info&)` (the stage too)}
 ///     \cgalParamDefault{none}
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{random_seed}
@@ -240,29 +159,17 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
   const auto t_start = std::chrono::steady_clock::now();
   const Point_map point_map = NP_helper::get_point_map(points, np);
   const Normal_map normal_map = NP_helper::get_normal_map(points, np);
-  const unsigned int k = choose_parameter(get_parameter(np, internal_np::number_of_neighbors),
-                                          default_number_of_neighbors);
-  const double radius = double(choose_parameter(get_parameter(np, CGAL::internal_np::neighbor_radius), 0.0));
-  const int threads = int(choose_parameter(get_parameter(np, internal_np::number_of_threads), 0));
+  const internal::Settings settings = internal::read_settings(np, "orient_normals");
+  const unsigned int k = settings.number_of_neighbors;
+  const double radius = settings.neighbor_radius;
   const auto criterion = choose_parameter(get_parameter(np, internal_np::flip_criterion), Hoppe_criterion());
-  const unsigned long seed =
-    (unsigned long)(choose_parameter(get_parameter(np, CGAL::internal_np::random_seed), 0u));
-  const auto solver = choose_parameter(get_parameter(np, internal_np::solver), Qpbo_i_solver(3, seed));
-  const std::function<bool(double)> callback =
-    choose_parameter(get_parameter(np, CGAL::internal_np::callback), std::function<bool(double)>());
+  const auto solver = choose_parameter(get_parameter(np, internal_np::solver), Qpbo_i_solver(3, settings.random_seed));
   constexpr bool has_constraints =
     !CGAL::parameters::is_default_parameter<NamedParameters, CGAL::internal_np::point_is_constrained_t>::value;
   constexpr bool has_prior =
     !CGAL::parameters::is_default_parameter<NamedParameters, internal_np::orientation_prior_map_t>::value;
   typedef std::conditional_t<has_constraints, Constrained_component_sign<>, Outward_component_sign> Default_sign;
   const auto sign_policy = choose_parameter(get_parameter(np, internal_np::component_sign), Default_sign());
-
-  if (k < 1 || k > 100000)
-    throw std::invalid_argument("orient_normals: number_of_neighbors must be between 1 and 100000");
-  if (radius != 0.0 && !(radius > 0.0 && std::isfinite(radius)))
-    throw std::invalid_argument("orient_normals: neighbor_radius must be a finite number > 0");
-  if (threads < 0)
-    throw std::invalid_argument("orient_normals: number_of_threads must be >= 0");
 
   Orientation_result result;
   result.criterion = internal::name_of(criterion);
@@ -329,9 +236,9 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
 
   std::vector<Label> input_labels(n, Label(1));
   try {
-    internal::run_with_threads(threads, [&]() {
-      const internal::Progress progress(callback);
-      progress.report(0.0);
+    internal::run_with_threads(settings.number_of_threads, [&]() {
+      const Progress_reporter& progress = settings.progress;
+      progress.part(Stage::INPUT, 0.0, 0.0).report(0.0);
 
       // Internally, points are numbered along a Morton curve: the kNN
       // queries, the graph, the solver and the sign policy then walk memory
@@ -368,7 +275,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       // 2. Graph.
       Neighbor_graph graph;
       const Neighbor_graph_report gr = build_neighbor_graph<ConcurrencyTag, Kernel>(
-        pts, nrm, k, radius, criterion, graph, progress.stage(0.0, 0.8));
+        pts, nrm, k, radius, criterion, graph, progress.part(Stage::GRAPH, 0.0, 0.8));
       result.number_of_edges = gr.number_of_edges;
       result.number_of_neighbors = gr.number_of_neighbors;
       result.neighbor_radius = gr.radius;
@@ -418,7 +325,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       result.frustrated_edges = sr.frustrated_edges;
       result.number_of_segments = sr.segments;
       result.seconds.solve = internal::seconds_since(t);
-      progress.report(0.9);
+      progress.part(Stage::SOLVE, 0.8, 0.9).report(1.0);
 
       // 4. Components and their signs.
       t = std::chrono::steady_clock::now();
@@ -426,7 +333,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       result.number_of_components = connected_components(graph, weight, component);
       const Component_sign_input<Kernel> input{pts, nrm, labels, component, result.number_of_components,
                                                gr.radius, has_constraints ? &constrained : nullptr};
-      std::vector<char> flip = sign_policy(input);
+      std::vector<char> flip = component_signs(sign_policy, input);
       // The solver gave the components with unary terms their sign.
       for (std::size_t i = 0; i < has_unary.size(); ++i)
         if (has_unary[i])
@@ -438,7 +345,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       for (std::size_t q = 0; q < n; ++q)
         input_labels[order[q]] = labels[q];
       result.seconds.sign = internal::seconds_since(t);
-      progress.report(1.0);
+      progress.part(Stage::SIGN, 0.9, 1.0).report(1.0);
     });
   } catch (const Interrupted&) {
     result.interrupted = true;

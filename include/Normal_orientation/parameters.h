@@ -10,7 +10,10 @@
 /// pack built with `CGAL::parameters::point_map(pm).normal_map(nm)` is accepted
 /// as is.  CGAL's list of names is closed, so the package's own names
 /// (`number_of_neighbors`, `flip_criterion`, `solver`, `component_sign`,
-/// `number_of_threads`, `orientation_prior_map`; all the names are described
+/// `number_of_threads`, `orientation_prior_map`, and the streaming driver's
+/// `presorted_axis`, `temporary_directory`, `sort_memory`,
+/// `refinement_rounds`, `minimum_component_size`, `component_files`,
+/// `batch_size`; all the names are described
 /// on the page \ref NormalOrientationNamedParameters) live in
 /// `Normal_orientation::parameters`, whose packs
 /// are CGAL packs (derived from `CGAL::Named_function_parameters`) that also
@@ -37,7 +40,14 @@ namespace internal_np {
   X(solver_t, solver, solver) \
   X(component_sign_t, component_sign, component_sign) \
   X(number_of_threads_t, number_of_threads, number_of_threads) \
-  X(orientation_prior_map_t, orientation_prior_map, orientation_prior_map)
+  X(orientation_prior_map_t, orientation_prior_map, orientation_prior_map) \
+  X(presorted_axis_t, presorted_axis, presorted_axis) \
+  X(temporary_directory_t, temporary_directory, temporary_directory) \
+  X(sort_memory_t, sort_memory, sort_memory) \
+  X(refinement_rounds_t, refinement_rounds, refinement_rounds) \
+  X(minimum_component_size_t, minimum_component_size, minimum_component_size) \
+  X(component_files_t, component_files, component_files) \
+  X(batch_size_t, batch_size, batch_size)
 
 #define NORMAL_ORIENTATION_DECLARE_TAG(X, Y, Z) enum X { Y };
 NORMAL_ORIENTATION_NAMED_PARAMETERS(NORMAL_ORIENTATION_DECLARE_TAG)

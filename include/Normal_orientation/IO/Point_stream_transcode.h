@@ -16,7 +16,7 @@
 
 #include <Normal_orientation/IO/Point_cloud_io.h>
 #include <Normal_orientation/IO/Point_stream.h>
-#include <Normal_orientation/internal/Progress.h>
+#include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Point_record.h>
 
 #include <algorithm>

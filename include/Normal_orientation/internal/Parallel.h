@@ -1,0 +1,111 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_INTERNAL_PARALLEL_H
+#define NORMAL_ORIENTATION_INTERNAL_PARALLEL_H
+
+/// \file Parallel.h
+/// Deterministic parallel loops and sorts (TBB when `ConcurrencyTag` is
+/// `CGAL::Parallel_tag` and TBB is linked, else sequential), and the Morton
+/// order both drivers walk the points in.
+
+#include <CGAL/number_utils.h>
+#include <CGAL/tags.h>
+
+#ifdef CGAL_LINKED_WITH_TBB
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+#endif
+
+#include <algorithm>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace Normal_orientation {
+namespace internal {
+
+/// Runs `f(begin, end)` over [0, n) in chunks, in parallel when
+/// `ConcurrencyTag` is `CGAL::Parallel_tag` and TBB is linked.
+template <typename ConcurrencyTag, typename F>
+void parallel_chunks(std::size_t n, const F& f, std::size_t grain = 1024)
+{
+#ifdef CGAL_LINKED_WITH_TBB
+  if (std::is_convertible<ConcurrencyTag, CGAL::Parallel_tag>::value) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, grain),
+                      [&](const tbb::blocked_range<std::size_t>& r) { f(r.begin(), r.end()); });
+    return;
+  }
+#endif
+  (void)grain;
+  f(std::size_t(0), n);
+}
+
+/// Sorts `v` with `less` (in parallel with TBB); the result is the same for
+/// any thread count when `less` is a strict total order.
+template <typename ConcurrencyTag, typename T, typename Less>
+void parallel_sort(std::vector<T>& v, Less less)
+{
+#ifdef CGAL_LINKED_WITH_TBB
+  if (std::is_convertible<ConcurrencyTag, CGAL::Parallel_tag>::value) {
+    tbb::parallel_sort(v.begin(), v.end(), less);
+    return;
+  }
+#endif
+  std::sort(v.begin(), v.end(), less);
+}
+
+/// spreads the low 21 bits of x to every third bit
+inline std::uint64_t spread_bits_3(std::uint64_t x)
+{
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+/// Returns the indices 0..n-1 in Morton (Z-curve) order of the points, ties
+/// broken by index: queries made in this order hit the kd-tree's caches.
+template <typename ConcurrencyTag, typename Point>
+std::vector<std::uint32_t> morton_order(const std::vector<Point>& points)
+{
+  const std::size_t n = points.size();
+  double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                  std::numeric_limits<double>::max()};
+  double hi[3] = {-lo[0], -lo[1], -lo[2]};
+  for (const Point& p : points)
+    for (int d = 0; d < 3; ++d) {
+      const double c = CGAL::to_double(p[d]);
+      lo[d] = std::min(lo[d], c);
+      hi[d] = std::max(hi[d], c);
+    }
+  double extent = 0.0;
+  for (int d = 0; d < 3; ++d)
+    extent = std::max(extent, hi[d] - lo[d]);
+  const double scale = extent > 0.0 ? double((1u << 21) - 1) / extent : 0.0;
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
+  parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      std::uint64_t code = 0;
+      for (int d = 0; d < 3; ++d)
+        code |= spread_bits_3(std::uint64_t((CGAL::to_double(points[i][d]) - lo[d]) * scale)) << d;
+      keyed[i] = {code, std::uint32_t(i)};
+    }
+  });
+  parallel_sort<ConcurrencyTag>(keyed, std::less<std::pair<std::uint64_t, std::uint32_t>>());
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t i = 0; i < n; ++i)
+    order[i] = keyed[i].second;
+  return order;
+}
+
+} // namespace internal
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_INTERNAL_PARALLEL_H

@@ -1,0 +1,174 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_STREAMING_SCAN_H
+#define NORMAL_ORIENTATION_STREAMING_SCAN_H
+
+/// \file Scan.h
+/// The first two stages of the streaming driver: the scan (one pass over
+/// the source: count, finiteness, zero normals, the sweep frame or the
+/// order of a presorted input, a uniform sample for the radius) and the
+/// radius, estimated from that sample by the rule of the in-core graph.
+
+#include <Normal_orientation/Neighbor_graph.h>
+#include <Normal_orientation/Point_record.h>
+#include <Normal_orientation/Progress.h>
+#include <Normal_orientation/internal/Parallel.h>
+#include <Normal_orientation/streaming/external_sort.h>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+namespace Normal_orientation {
+namespace streaming {
+/// \cond SKIP_IN_MANUAL
+namespace internal {
+
+/// What the scan found.
+template <typename Point>
+struct Scan_result
+{
+  std::uint64_t number_of_points = 0;
+  std::uint64_t number_of_zero_normals = 0;
+  Sweep_frame frame;         ///< the principal frame (not for a presorted input)
+  std::vector<Point> sample; ///< a uniform sample (when the radius is to be estimated)
+};
+
+/// The points of the radius sample
+constexpr std::size_t radius_sample_size = 200000;
+
+/// Reads `source` once, from its start, and rewinds it.  `axis` is the
+/// presorted coordinate (0, 1, 2), or -1 for an input in any order, whose
+/// principal frame is then computed.  A deterministic reservoir sample of
+/// at most `radius_sample_size` points is kept when `sample` is true.
+/// \throw std::runtime_error for non-finite coordinates, or for a presorted
+///        input out of order (naming the point)
+template <typename Point, typename Source>
+Scan_result<Point> scan(Source& source, int axis, bool sample, const Progress_reporter& progress)
+{
+  Scan_result<Point> result;
+  Moment_accumulator moments;
+  std::mt19937_64 rng(0x5eed);
+  std::vector<Point_record> chunk;
+  chunk.reserve(65536);
+  double last = -HUGE_VAL;
+  std::uint64_t n = 0, non_finite = 0;
+  progress.report(0, 0);
+  source.rewind();
+  while (true) {
+    chunk.clear();
+    if (source.read(chunk, 65536) == 0)
+      break;
+    for (const Point_record& r : chunk) {
+      const bool finite = std::isfinite(r.position[0]) && std::isfinite(r.position[1]) && std::isfinite(r.position[2]);
+      if (!finite)
+        ++non_finite;
+      if (r.normal[0] == 0.0 && r.normal[1] == 0.0 && r.normal[2] == 0.0)
+        ++result.number_of_zero_normals;
+      if (axis >= 0) {
+        if (finite) {
+          const double v = r.position[axis];
+          if (v < last) {
+            std::ostringstream msg;
+            msg.precision(17);
+            msg << "streaming_orient_normals: the input is not sorted by increasing " << char('x' + axis)
+                << " (presorted_axis): point " << n << " (input index " << r.index << ") has " << char('x' + axis)
+                << " = " << v << ", below the previous point's " << last;
+            throw std::runtime_error(msg.str());
+          }
+          last = v;
+        }
+      } else
+        moments.add(r);
+      if (sample) {
+        const Point p(r.position[0], r.position[1], r.position[2]);
+        if (result.sample.size() < radius_sample_size)
+          result.sample.push_back(p);
+        else {
+          const std::uint64_t j = rng() % (n + 1);
+          if (j < radius_sample_size)
+            result.sample[std::size_t(j)] = p;
+        }
+      }
+      ++n;
+    }
+    progress.report(n, 0);
+  }
+  source.rewind();
+  if (axis < 0)
+    result.frame = moments.frame();
+  result.number_of_points = n;
+  progress.report(n, n);
+  if (non_finite > 0)
+    throw std::runtime_error("streaming_orient_normals: the input has points with non-finite coordinates");
+  return result;
+}
+
+/// r for a cloud of `n` points of which `sample` is a uniform sample: the
+/// rule of `estimate_neighbor_radius()` over the sample's k-th neighbour
+/// distances, scaled by sqrt(sample / n) (the spacing of a surface sample).
+/// `sample` is reordered.
+template <typename ConcurrencyTag, typename Kernel>
+double sample_radius(std::vector<typename Kernel::Point_3>& sample, unsigned int k, std::uint64_t n)
+{
+  const unsigned int ks = unsigned(std::min<std::size_t>(k, sample.size() > 1 ? sample.size() - 1 : 0));
+  if (ks == 0)
+    return 1.0;
+  { // queries in Morton order are several times faster (the quantile does not depend on the order)
+    const std::vector<std::uint32_t> order = Normal_orientation::internal::morton_order<ConcurrencyTag>(sample);
+    std::vector<typename Kernel::Point_3> sorted(sample.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+      sorted[i] = sample[order[i]];
+    sample.swap(sorted);
+  }
+  std::vector<std::uint32_t> nb;
+  std::vector<float> d2;
+  Normal_orientation::internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(sample, ks, nb, d2, Progress_reporter(),
+                                                                             0, 1);
+  std::vector<float> kth(sample.size());
+  for (std::size_t i = 0; i < sample.size(); ++i)
+    kth[i] = d2[i * ks + (ks - 1)];
+  return estimate_neighbor_radius(kth, std::sqrt(double(sample.size()) / double(n)));
+}
+
+/// A source that reports, after every read, the number of records read so
+/// far (for the progress of the external sort).
+template <typename Source>
+class Reporting_source
+{
+public:
+  /// reports to `progress` the records read of `total`
+  Reporting_source(Source& source, const Progress_reporter& progress, std::uint64_t total)
+    : m_source(source), m_progress(progress), m_total(total)
+  {}
+  /// reads as `Source::read()` does, then reports
+  std::size_t read(std::vector<Point_record>& chunk, std::size_t maximum)
+  {
+    const std::size_t got = m_source.read(chunk, maximum);
+    m_count += got;
+    m_progress.report(std::min(m_count, m_total), m_total);
+    return got;
+  }
+  /// rewinds the source
+  void rewind()
+  {
+    m_source.rewind();
+    m_count = 0;
+  }
+
+private:
+  Source& m_source;
+  const Progress_reporter& m_progress;
+  std::uint64_t m_total;
+  std::uint64_t m_count = 0;
+};
+
+} // namespace internal
+/// \endcond
+} // namespace streaming
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_STREAMING_SCAN_H

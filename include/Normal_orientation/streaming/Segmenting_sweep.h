@@ -1,0 +1,184 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_STREAMING_SEGMENTING_SWEEP_H
+#define NORMAL_ORIENTATION_STREAMING_SEGMENTING_SWEEP_H
+
+/// \file Segmenting_sweep.h
+/// The sweep stage of the streaming driver: the sweep's visitor that
+/// weighs each point's earlier edges with the flip criterion, segments the
+/// point (`Segmenter`), and writes it to the record file (and its edges to
+/// the edge file of the refinement) when it leaves the window.
+
+#include <Normal_orientation/Orientation_problem.h>
+#include <Normal_orientation/Point_record.h>
+#include <Normal_orientation/Progress.h>
+#include <Normal_orientation/Segmenter.h>
+#include <Normal_orientation/internal/Parallel.h>
+#include <Normal_orientation/streaming/Record_file.h>
+#include <Normal_orientation/streaming/Refinement.h>
+#include <Normal_orientation/streaming/Sweep.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+namespace Normal_orientation {
+namespace streaming {
+/// \cond SKIP_IN_MANUAL
+namespace internal {
+
+/// a point after the sweep: the record, its segment and its preliminary flip
+struct Swept_record
+{
+  Point_record record;
+  std::uint32_t segment;
+  std::int32_t flip;
+};
+
+/// what the sweep keeps per point in its window
+struct Sweep_payload
+{
+  std::uint32_t segment = 0;
+  Label flip = 1;
+};
+
+/// unit normal of a record (zero when the normal is zero)
+inline std::array<double, 3> unit_normal(const Point_record& r)
+{
+  const double l2 = r.normal[0] * r.normal[0] + r.normal[1] * r.normal[1] + r.normal[2] * r.normal[2];
+  if (!(l2 > 0.0))
+    return {0.0, 0.0, 0.0};
+  const double inv = 1.0 / std::sqrt(l2);
+  return {r.normal[0] * inv, r.normal[1] * inv, r.normal[2] * inv};
+}
+
+/// What the sweep stage leaves: the segmentation, per segment its size and
+/// whether a point of it has a unary term, and the figures of the sweep.
+struct Sweep_stage_result
+{
+  std::vector<std::uint64_t> segment_size;
+  std::vector<char> segment_has_unary;
+  std::uint64_t edge_span = 0;       ///< the farthest back an edge reaches
+  std::uint64_t unary_terms = 0;     ///< points with a unary term
+  double energy_before = 0.0;        ///< the energy of the input orientation, summed in the sweep order
+};
+
+/// The visitor of `sweep()` for the streaming driver.  `Unary` is callable
+/// as `double(const Point_record&)`: the point's preference for its input
+/// sign (> 0 keep, < 0 flip, 0 none; see `orient_normals()`).
+template <typename ConcurrencyTag, typename Kernel, typename FlipCriterion, typename Unary>
+class Segmenting_visitor
+{
+  typedef typename Kernel::Point_3 Point;
+  typedef typename Kernel::Vector_3 Vector;
+
+public:
+  Segmenting_visitor(const FlipCriterion& criterion, const Unary& unary, Segmenter& segmenter,
+                     Record_file<Swept_record>& records, Record_file<Earlier_edge>* edges, double radius,
+                     const Progress_reporter& progress, std::uint64_t n, Sweep_stage_result& out)
+    : m_criterion(criterion), m_unary(unary), m_segmenter(segmenter), m_records(records), m_edges(edges),
+      m_r2(radius * radius), m_progress(progress), m_n(n), m_out(out)
+  {}
+
+  /// The edge weights of a whole batch, in parallel, with the input normals
+  /// (as in the in-core graph, in single precision); the neighbours'
+  /// preliminary flips are applied in `finalize`.
+  void prepare(Sweep_window<Sweep_payload>& w, std::uint64_t first, const std::vector<std::size_t>& offsets,
+               const std::vector<Sweep_neighbor>& neighbors)
+  {
+    m_progress.report(first, m_n); // `first` points are finalised
+    m_weights.resize(neighbors.size());
+    m_cursor = 0;
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(offsets.size() - 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t q = b; q < e; ++q) {
+        const Point_record& p = w.record(first + q);
+        const std::array<double, 3> np = unit_normal(p);
+        const Point pp(p.position[0], p.position[1], p.position[2]);
+        const Vector vp(np[0], np[1], np[2]);
+        for (std::size_t t = offsets[q]; t < offsets[q + 1]; ++t) {
+          const Point_record& o = w.record(neighbors[t].sequence);
+          const std::array<double, 3> no = unit_normal(o);
+          const double omega = 1.0 - double(neighbors[t].squared_distance) / m_r2;
+          m_weights[t] = float(m_criterion(pp, vp, Point(o.position[0], o.position[1], o.position[2]),
+                                           Vector(no[0], no[1], no[2])) *
+                               omega);
+        }
+      }
+    }, 256);
+  }
+
+  /// segments point `s`, whose earlier neighbours are `earlier`
+  void finalize(Sweep_window<Sweep_payload>& w, std::uint64_t s, const std::vector<Sweep_neighbor>& earlier)
+  {
+    m_votes.clear();
+    if (m_edges != nullptr) { // a header (the number of edges), then the edges
+      const std::uint64_t farthest = earlier.empty() ? 0 : s - earlier.front().sequence; // sorted
+      if (farthest > std::uint64_t(std::numeric_limits<std::uint32_t>::max()) ||
+          earlier.size() > std::size_t(std::numeric_limits<std::uint32_t>::max()))
+        throw std::length_error("streaming_orient_normals: the sweep window is too large for the refinement");
+      m_out.edge_span = std::max(m_out.edge_span, farthest);
+      m_edges->append(Earlier_edge{std::uint32_t(earlier.size()), 0.0f});
+    }
+    for (const Sweep_neighbor& nb : earlier) {
+      const Sweep_payload& pq = w.payload(nb.sequence);
+      const float weight = m_weights[m_cursor++];
+      m_votes.push_back({pq.segment, double(weight) * double(pq.flip)});
+      m_out.energy_before += edge_energy(double(weight), Label(1), Label(1));
+      if (m_edges != nullptr)
+        m_edges->append(Earlier_edge{std::uint32_t(s - nb.sequence), weight});
+    }
+    double preference = 0.0;
+    const Point_record& record = w.record(s);
+    if (Unary::enabled && (record.normal[0] != 0.0 || record.normal[1] != 0.0 || record.normal[2] != 0.0))
+      preference = m_unary(record);
+    const Segment_assignment a = m_segmenter.add_point(m_votes, preference);
+    w.payload(s) = Sweep_payload{a.segment, a.flip};
+    if (a.segment >= m_out.segment_size.size()) {
+      m_out.segment_size.resize(a.segment + 1, 0);
+      m_out.segment_has_unary.resize(a.segment + 1, 0);
+    }
+    ++m_out.segment_size[a.segment];
+    if (preference != 0.0) {
+      m_out.segment_has_unary[a.segment] = 1;
+      ++m_out.unary_terms;
+    }
+  }
+
+  /// writes point `s`, leaving the window, to the record file
+  void release(Sweep_window<Sweep_payload>& w, std::uint64_t s)
+  {
+    m_records.append(Swept_record{w.record(s), w.payload(s).segment, std::int32_t(w.payload(s).flip)});
+  }
+
+private:
+  const FlipCriterion& m_criterion;
+  const Unary& m_unary;
+  Segmenter& m_segmenter;
+  Record_file<Swept_record>& m_records;
+  Record_file<Earlier_edge>* m_edges;
+  double m_r2;
+  const Progress_reporter& m_progress;
+  std::uint64_t m_n;
+  Sweep_stage_result& m_out;
+  std::vector<Neighbor_vote> m_votes;
+  std::vector<float> m_weights;
+  std::size_t m_cursor = 0;
+};
+
+/// No unary term.
+struct No_unary
+{
+  static constexpr bool enabled = false;
+  double operator()(const Point_record&) const { return 0.0; }
+};
+
+} // namespace internal
+/// \endcond
+} // namespace streaming
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_STREAMING_SEGMENTING_SWEEP_H
