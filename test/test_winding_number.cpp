@@ -1,0 +1,356 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// Tests of Winding_number_field and estimate_point_areas: the treecode against
+// the direct sum, a sampled sphere, a flipped patch, thread counts, areas.
+
+#include <Normal_orientation/Winding_number_field.h>
+
+#include "Synthetic_shapes.h"
+
+#include <gtest/gtest.h>
+
+#ifdef CGAL_LINKED_WITH_TBB
+#include <tbb/global_control.h>
+#endif
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <iostream>
+#include <random>
+#include <vector>
+
+namespace NO = Normal_orientation;
+using NO::test::Kernel;
+using NO::test::Point;
+using NO::test::Vector;
+typedef NO::Winding_number_field<Kernel> Field;
+
+namespace {
+
+struct Cloud
+{
+  std::vector<Point> points;
+  std::vector<Vector> normals;
+  std::vector<double> areas;
+};
+
+Cloud make_cloud(const std::vector<NO::test::Sample>& samples)
+{
+  Cloud c;
+  for (const NO::test::Sample& s : samples) {
+    c.points.push_back(s.p);
+    c.normals.push_back(s.n);
+  }
+  c.areas = NO::estimate_point_areas(c.points, c.normals);
+  return c;
+}
+
+Cloud sphere_cloud(std::size_t n, unsigned seed)
+{
+  std::mt19937_64 rng(seed);
+  return make_cloud(NO::test::sphere(n, rng));
+}
+
+/// queries: half uniform in [-1.6, 1.6]^3, half at distance `offset` on
+/// either side of random samples, and a few on samples
+std::vector<Point> make_queries(const Cloud& c, std::size_t m, unsigned seed, double offset = 0.02)
+{
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.6, 1.6);
+  std::uniform_int_distribution<std::size_t> pick(0, c.points.size() - 1);
+  std::vector<Point> q;
+  for (std::size_t t = 0; t < m; ++t) {
+    if (t % 2 == 0) {
+      const double x = u(rng), y = u(rng), z = u(rng);
+      q.push_back(Point(x, y, z));
+    } else {
+      const std::size_t i = pick(rng);
+      const double side = t % 4 == 1 ? 1.0 : -1.0;
+      q.push_back(t % 20 == 19 ? c.points[i] : c.points[i] + side * offset * c.normals[i]);
+    }
+  }
+  return q;
+}
+
+double max_abs_difference(const std::vector<double>& a, const std::vector<double>& b)
+{
+  double e = 0.0;
+  for (std::size_t t = 0; t < a.size(); ++t)
+    e = std::max(e, std::abs(a[t] - b[t]));
+  return e;
+}
+
+bool same_bits(const std::vector<double>& a, const std::vector<double>& b)
+{
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0;
+}
+
+} // namespace
+
+TEST(WindingNumberAreas, SumToTheAreaOfASphere)
+{
+  const Cloud c = sphere_cloud(20000, 1);
+  double sum = 0.0;
+  for (double a : c.areas) {
+    ASSERT_GT(a, 0.0);
+    sum += a;
+  }
+  std::cout << "sum of areas / 4 pi = " << sum / (4.0 * M_PI) << "\n";
+  EXPECT_NEAR(sum / (4.0 * M_PI), 1.0, 0.03);
+}
+
+TEST(WindingNumberAreas, RegularGridDuplicatesAndSmallClouds)
+{
+  // a 20 x 20 grid of spacing h in the plane z = 1: interior cells are h x h squares
+  const double h = 0.1;
+  std::vector<Point> points;
+  std::vector<Vector> normals;
+  for (int a = 0; a < 20; ++a)
+    for (int b = 0; b < 20; ++b) {
+      points.push_back(Point(a * h, b * h, 1.0));
+      normals.push_back(Vector(0, 0, b % 2 ? 2.0 : -1.0)); // any length and sign
+    }
+  const std::vector<double> areas = NO::estimate_point_areas<CGAL::Sequential_tag>(points, normals);
+  for (int a = 0; a < 20; ++a)
+    for (int b = 0; b < 20; ++b) {
+      const double area = areas[std::size_t(a * 20 + b)];
+      if (a > 1 && a < 18 && b > 1 && b < 18) {
+        EXPECT_NEAR(area, h * h, 1e-12);
+      }
+      EXPECT_TRUE(std::isfinite(area) && area > 0.0 && area < 8 * h * h) << area / (h * h);
+    }
+  // every point twice: each of a pair gets half the cell
+  std::vector<Point> twice = points;
+  twice.insert(twice.end(), points.begin(), points.end());
+  std::vector<Vector> twice_normals = normals;
+  twice_normals.insert(twice_normals.end(), normals.begin(), normals.end());
+  const std::vector<double> halves = NO::estimate_point_areas(twice, twice_normals);
+  EXPECT_NEAR(halves[5 * 20 + 5], 0.5 * h * h, 1e-12);
+  EXPECT_NEAR(halves[400 + 5 * 20 + 5], 0.5 * h * h, 1e-12);
+  // a zero normal: the disc estimate
+  normals[5 * 20 + 5] = Vector(0, 0, 0);
+  const std::vector<double> disc = NO::estimate_point_areas(points, normals);
+  EXPECT_NEAR(disc[5 * 20 + 5], M_PI * 5 * h * h / 17.0, 1e-12); // d_16 = sqrt(5) h
+  // 0 and 1 points; bad arguments
+  EXPECT_TRUE(NO::estimate_point_areas(std::vector<Point>(), std::vector<Vector>()).empty());
+  EXPECT_EQ(NO::estimate_point_areas(std::vector<Point>(1, Point(0, 0, 0)), std::vector<Vector>(1, Vector(0, 0, 1)))[0],
+            0.0);
+  EXPECT_THROW(NO::estimate_point_areas(points, normals, 0), std::invalid_argument);
+  EXPECT_THROW(NO::estimate_point_areas(points, normals, 65), std::invalid_argument);
+  normals.pop_back();
+  EXPECT_THROW(NO::estimate_point_areas(points, normals), std::invalid_argument);
+}
+
+TEST(WindingNumberField, TreecodeMatchesTheDirectSum)
+{
+  for (int shape = 0; shape < 2; ++shape) {
+    std::mt19937_64 rng(7);
+    const Cloud c = shape == 0 ? make_cloud(NO::test::sphere(50000, rng)) : make_cloud(NO::test::torus(50000, rng));
+    Field field;
+    field.build(c.points, c.normals, c.areas);
+    const std::vector<Point> q = make_queries(c, 2000, 11);
+    std::vector<double> exact, approx;
+    std::vector<Vector> exact_g, approx_g;
+    field.evaluate_direct(q, exact, exact_g);
+    // beta -> the bound on |w - w_direct| and on |grad w - grad_direct| / max(1, |grad_direct|)
+    const double betas[3] = {1.5, 2.0, 3.0};
+    const double bounds[3] = {0.05, 0.015, 0.003};
+    for (int b = 0; b < 3; ++b) {
+      field.set_opening_ratio(betas[b]);
+      field.evaluate(q, approx, approx_g);
+      double gradient_error = 0.0;
+      for (std::size_t t = 0; t < q.size(); ++t) {
+        const double scale = std::max(1.0, std::sqrt(exact_g[t].squared_length()));
+        gradient_error = std::max(gradient_error, std::sqrt((approx_g[t] - exact_g[t]).squared_length()) / scale);
+      }
+      const double error = max_abs_difference(approx, exact);
+      double mean = 0.0;
+      for (std::size_t t = 0; t < q.size(); ++t)
+        mean += std::abs(approx[t] - exact[t]) / double(q.size());
+      std::cout << (shape == 0 ? "sphere" : "torus") << " beta " << betas[b] << ": mean |w error| " << mean
+                << ", max |w error| " << error
+                << ", max relative gradient error " << gradient_error << "\n";
+      EXPECT_LT(error, bounds[b]);
+      EXPECT_LT(gradient_error, 16.0 * bounds[b]);
+      // one query at a time gives the same values
+      for (std::size_t t = 0; t < q.size(); t += 97)
+        EXPECT_EQ(field.value(q[t]), approx[t]);
+    }
+  }
+}
+
+TEST(WindingNumberField, SampledSphereIsOneInsideZeroOutsideHalfOnTheSurface)
+{
+  const Cloud c = sphere_cloud(20000, 3);
+  Field field;
+  field.build(c.points, c.normals, c.areas);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> g;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double inside = 0.0, outside = 0.0, surface = 0.0;
+  for (int t = 0; t < 2000; ++t) {
+    const double z = g(rng), y = g(rng), x = g(rng);
+    const Vector d = NO::test::unit(Vector(x, y, z));
+    inside = std::max(inside, std::abs(field.value(Point(0, 0, 0) + 0.8 * std::cbrt(u(rng)) * d) - 1.0));
+    outside = std::max(outside, std::abs(field.value(Point(0, 0, 0) + (1.2 + 2.0 * u(rng)) * d)));
+  }
+  for (std::size_t i = 0; i < c.points.size(); i += 10)
+    surface = std::max(surface, std::abs(field.value(c.points[i]) - 0.5));
+  std::cout << "sphere: max |w - 1| inside " << inside << ", max |w| outside " << outside
+            << ", max |w - 1/2| on samples " << surface << "\n";
+  EXPECT_LT(inside, 0.03);
+  EXPECT_LT(outside, 0.015);
+  EXPECT_LT(surface, 0.05);
+  // just off the surface, on either side of a sample
+  const double eps = field.smoothing_width(0);
+  EXPECT_GT(field.value(c.points[0] - 3.0 * eps * c.normals[0]), 0.75);
+  EXPECT_LT(field.value(c.points[0] + 3.0 * eps * c.normals[0]), 0.25);
+  // grad w points inward (-n) on the surface
+  EXPECT_LT(field.gradient(c.points[0]) * c.normals[0], 0.0);
+  // unsmoothed: still finite on the samples, and the same far from them
+  Field sharp;
+  sharp.set_smoothing_factor(0.0);
+  sharp.build(c.points, c.normals, c.areas);
+  EXPECT_TRUE(std::isfinite(sharp.value(c.points[0])));
+  EXPECT_NEAR(sharp.value(Point(0.1, 0.2, 0.3)), field.value(Point(0.1, 0.2, 0.3)), 5e-3);
+}
+
+TEST(WindingNumberField, FlippingAPatchSubtractsTwiceItsField)
+{
+  const Cloud c = sphere_cloud(30000, 9);
+  std::vector<std::size_t> patch;
+  Cloud p;
+  for (std::size_t i = 0; i < c.points.size(); ++i)
+    if (c.points[i].z() > 0.4 && c.points[i].x() > -0.2) {
+      patch.push_back(i);
+      p.points.push_back(c.points[i]);
+      p.normals.push_back(c.normals[i]);
+      p.areas.push_back(c.areas[i]);
+    }
+  Field whole, part;
+  whole.build(c.points, c.normals, c.areas);
+  part.build(p.points, p.normals, p.areas);
+  const std::vector<Point> q = make_queries(c, 1000, 13, 0.05);
+  std::vector<double> before, own, after, before_direct, own_direct, after_direct;
+  whole.evaluate(q, before);
+  whole.evaluate_direct(q, before_direct);
+  part.evaluate(q, own);
+  part.evaluate_direct(q, own_direct);
+  whole.negate(patch);
+  EXPECT_TRUE(whole.is_negated(patch[0]));
+  EXPECT_FALSE(whole.is_negated(0) && patch[0] != 0);
+  whole.evaluate(q, after);
+  whole.evaluate_direct(q, after_direct);
+  double direct_error = 0.0, tree_error = 0.0, largest = 0.0;
+  for (std::size_t t = 0; t < q.size(); ++t) {
+    direct_error = std::max(direct_error, std::abs(after_direct[t] - (before_direct[t] - 2.0 * own_direct[t])));
+    tree_error = std::max(tree_error, std::abs(after[t] - (before[t] - 2.0 * own[t])));
+    largest = std::max(largest, std::abs(own_direct[t]));
+  }
+  std::cout << "flipped patch: max |w_P| " << largest << ", direct error " << direct_error << ", treecode error "
+            << tree_error << "\n";
+  EXPECT_GT(largest, 0.4);
+  EXPECT_LT(direct_error, 1e-12);
+  EXPECT_LT(tree_error, 0.02);
+
+  // the same, bit for bit, as a field built with those normals negated
+  std::vector<Vector> flipped = c.normals;
+  for (std::size_t i : patch)
+    flipped[i] = -flipped[i];
+  Field rebuilt;
+  rebuilt.build(c.points, flipped, c.areas);
+  std::vector<double> fresh;
+  rebuilt.evaluate(q, fresh);
+  EXPECT_TRUE(same_bits(fresh, after));
+  // and negating again restores the field exactly
+  whole.negate(patch);
+  whole.evaluate(q, after);
+  EXPECT_TRUE(same_bits(before, after));
+  EXPECT_THROW(whole.negate(std::vector<std::size_t>(1, c.points.size())), std::out_of_range);
+}
+
+TEST(WindingNumberField, SameOutputForOneAndTwoThreads)
+{
+  const Cloud c = sphere_cloud(100000, 17);
+  const std::vector<Point> q = make_queries(c, 20000, 19);
+  std::vector<double> values[3];
+  std::vector<Vector> gradients[3];
+  std::vector<double> areas[3];
+  for (int run = 0; run < 3; ++run) {
+    Field field;
+    if (run == 0) {
+      areas[run] = NO::estimate_point_areas<CGAL::Sequential_tag>(c.points, c.normals);
+      field.build<CGAL::Sequential_tag>(c.points, c.normals, areas[run]);
+      field.evaluate<CGAL::Sequential_tag>(q, values[run], gradients[run]);
+      continue;
+    }
+#ifdef CGAL_LINKED_WITH_TBB
+    tbb::global_control threads(tbb::global_control::max_allowed_parallelism, std::size_t(run));
+    areas[run] = NO::estimate_point_areas<CGAL::Parallel_tag>(c.points, c.normals);
+    field.build<CGAL::Parallel_tag>(c.points, c.normals, areas[run]);
+    field.evaluate<CGAL::Parallel_tag>(q, values[run], gradients[run]);
+#else
+    areas[run] = areas[0];
+    values[run] = values[0];
+    gradients[run] = gradients[0];
+#endif
+  }
+  for (int run = 1; run < 3; ++run) {
+    EXPECT_TRUE(same_bits(areas[0], areas[run]));
+    EXPECT_TRUE(same_bits(values[0], values[run]));
+    bool same = true;
+    for (std::size_t t = 0; t < q.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        same = same && gradients[0][t][k] == gradients[run][t][k];
+    EXPECT_TRUE(same);
+  }
+}
+
+TEST(WindingNumberField, GradientMatchesFiniteDifferences)
+{
+  std::mt19937_64 rng(23);
+  const Cloud c = make_cloud(NO::test::torus(20000, rng));
+  Field field;
+  field.build(c.points, c.normals, c.areas);
+  const std::vector<Point> q = make_queries(c, 200, 29, 0.05);
+  const double h = 1e-5;
+  for (const Point& x : q) {
+    const Vector g = field.direct_gradient(x);
+    for (int k = 0; k < 3; ++k) {
+      const Vector e(k == 0 ? h : 0.0, k == 1 ? h : 0.0, k == 2 ? h : 0.0);
+      const double fd = (field.direct_value(x + e) - field.direct_value(x - e)) / (2.0 * h);
+      EXPECT_NEAR(g[k], fd, 1e-4 * std::max(1.0, std::abs(fd)));
+    }
+  }
+}
+
+TEST(WindingNumberField, SmallAndBadInputs)
+{
+  Field empty;
+  EXPECT_EQ(empty.size(), 0u);
+  EXPECT_EQ(empty.value(Point(1, 2, 3)), 0.0);
+  EXPECT_EQ(empty.gradient(Point(1, 2, 3)), Vector(0, 0, 0));
+  // one point: the formula itself; a zero normal contributes nothing
+  Field one;
+  one.build(std::vector<Point>{Point(0, 0, 0), Point(5, 5, 5)}, std::vector<Vector>{Vector(0, 0, 2), Vector(0, 0, 0)},
+            std::vector<double>{0.5, 1.0});
+  const double r = 2.0, e2 = 0.5;
+  EXPECT_NEAR(one.value(Point(0, 0, -r)), 0.5 * r / std::pow(r * r + e2, 1.5) / (4.0 * M_PI), 1e-15);
+  EXPECT_NEAR(one.direct_value(Point(0, 0, -r)), one.value(Point(0, 0, -r)), 1e-15);
+  EXPECT_EQ(one.value(Point(0, 0, 0)), 0.0);
+  std::vector<Point> pts(3, Point(0, 0, 0));
+  std::vector<Vector> nrm(3, Vector(0, 0, 1));
+  EXPECT_THROW(empty.build(pts, nrm, std::vector<double>(2, 1.0)), std::invalid_argument);
+  EXPECT_THROW(empty.build(pts, nrm, std::vector<double>{1.0, -1.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW(empty.build(pts, nrm, std::vector<double>(3, 1.0), 0), std::invalid_argument);
+  pts[1] = Point(std::nan(""), 0, 0);
+  EXPECT_THROW(empty.build(pts, nrm, std::vector<double>(3, 1.0)), std::invalid_argument);
+  EXPECT_THROW(empty.set_opening_ratio(0.0), std::invalid_argument);
+  EXPECT_THROW(empty.set_smoothing_factor(-1.0), std::invalid_argument);
+  // coincident points (a node of radius 0) and a leaf size of 1
+  Field same;
+  same.build(std::vector<Point>(100, Point(1, 1, 1)), std::vector<Vector>(100, Vector(1, 0, 0)),
+             std::vector<double>(100, 0.01), 1);
+  EXPECT_NEAR(same.value(Point(0, 1, 1)), same.direct_value(Point(0, 1, 1)), 1e-15);
+  EXPECT_TRUE(std::isfinite(same.value(Point(1, 1, 1))));
+}
