@@ -2410,7 +2410,7 @@ TEST(Transcode, the_reader_gives_the_ply_layout)
 {
   Temporary_directory directory;
   write_file(directory.file("cloud.xyz"), "1 2 3\n");
-  EXPECT_FALSE(Point_stream_reader(directory.file("cloud.xyz")).ply_layout().has_value());
+  EXPECT_FALSE(Normal_orientation::IO::internal::ply_layout(Point_stream_reader(directory.file("cloud.xyz"))).has_value());
   Transcode_ply spec;
   spec.format = "binary_big_endian";
   spec.other_elements = true;
@@ -2419,7 +2419,7 @@ TEST(Transcode, the_reader_gives_the_ply_layout)
   write_file(directory.file("cloud.ply"), content);
   Point_stream_reader reader(directory.file("cloud.ply"));
   EXPECT_EQ(reader.file_size(), content.size());
-  const auto layout = reader.ply_layout();
+  const auto layout = Normal_orientation::IO::internal::ply_layout(reader);
   ASSERT_TRUE(layout.has_value());
   EXPECT_EQ(layout->format, Normal_orientation::IO::internal::Ply_format::BINARY_BIG_ENDIAN);
   ASSERT_EQ(layout->elements.size(), 3u);
