@@ -103,9 +103,8 @@ inline std::optional<Ply_stream_layout> ply_layout(const Point_stream_reader& re
 ///
 /// Limits that `read_point_cloud()` does not have: a line of a text file must fit in
 /// the buffer (`buffer_capacity()`), except a comment line of a `.xyz`/`.pwn` file,
-/// which may be of any length; a PLY header is read up to
-/// 1 MiB (`internal::max_streamed_ply_header_size`); the file must be seekable
-/// (a regular file, not a pipe).
+/// which may be of any length; a PLY header is read up to 1 MiB; the file must be
+/// seekable (a regular file, not a pipe).
 class Point_stream_reader
 {
 public:
@@ -200,7 +199,9 @@ public:
   }
 
 private:
+  /// \cond SKIP_IN_MANUAL
   friend std::optional<internal::Ply_stream_layout> internal::ply_layout(const Point_stream_reader&);
+  /// \endcond
 
   /// The layout of a PLY file (see `internal::ply_layout()`).
   std::optional<internal::Ply_stream_layout> ply_layout() const

@@ -61,7 +61,7 @@ struct Point_stream_write_options
 /// written in the header as a fixed-width field, has been set). A writer destroyed
 /// without `commit()`, for instance after an exception, removes its temporary file: no
 /// output file appears and an existing `filename` is unchanged. Memory use is a fixed
-/// buffer of `internal::Atomic_output_file::capacity` bytes.
+/// buffer of 1 MiB.
 class Point_stream_writer
 {
 public:
