@@ -164,16 +164,27 @@ private:
     check_finite_values(filename_, record.position, options_.normals ? record.normal : nullptr,
                         "vertex", count_);
     const std::size_t values = options_.normals ? 6 : 3;
-    const bool binary = ply_ && options_.binary; // else text: PLY ASCII and .xyz/.pwn write the same
-    for(std::size_t c = 0; c < values; ++c) {
-      if(!binary && c != 0) out_->put(' ');
-      put_ply_value(*out_, c < 3 ? record.position[c] : record.normal[c - 3], Ply_scalar_type::FLOAT64, binary);
+    if(ply_ && options_.binary) { // one room for the whole row: this is the hot path of large outputs
+      const std::size_t size = values * sizeof(double) + (options_.segments ? 4 : 0);
+      char* const target = out_->room(size);
+      const bool swap = !host_is_little_endian();
+      for(std::size_t c = 0; c < values; ++c)
+        store_scalar(target + c * sizeof(double), c < 3 ? record.position[c] : record.normal[c - 3],
+                     Ply_scalar_type::FLOAT64, swap);
+      if(options_.segments)
+        store_scalar(target + values * sizeof(double), static_cast<double>(segment), Ply_scalar_type::INT32, swap);
+      out_->advance(size);
+    } else { // text: PLY ASCII and .xyz/.pwn write the same
+      for(std::size_t c = 0; c < values; ++c) {
+        if(c != 0) out_->put(' ');
+        put_ply_value(*out_, c < 3 ? record.position[c] : record.normal[c - 3], Ply_scalar_type::FLOAT64, false);
+      }
+      if(options_.segments) {
+        out_->put(' ');
+        put_ply_value(*out_, static_cast<double>(segment), Ply_scalar_type::INT32, false);
+      }
+      out_->put('\n');
     }
-    if(options_.segments) {
-      if(!binary) out_->put(' ');
-      put_ply_value(*out_, static_cast<double>(segment), Ply_scalar_type::INT32, binary);
-    }
-    if(!binary) out_->put('\n');
     ++count_;
   }
 
