@@ -341,10 +341,10 @@ Options parse_options(int argc, char** argv)
                          : o.input + "_oriented.ply";
     }
   }
-  if (o.write_segments && NO::IO::internal::lower_case_extension(o.output) != ".ply")
+  if (o.write_segments && NO::IO::lower_case_extension(o.output) != ".ply")
     throw Usage_error("--write-segments needs a .ply OUT");
-  if (o.keep_order && (NO::IO::internal::lower_case_extension(o.input) == ".ply") !=
-                        (NO::IO::internal::lower_case_extension(o.output) == ".ply"))
+  if (o.keep_order && (NO::IO::lower_case_extension(o.input) == ".ply") !=
+                        (NO::IO::lower_case_extension(o.output) == ".ply"))
     throw Usage_error("--keep-order writes OUT in the format of IN: OUT must be a .ply file for a .ply IN, "
                       "a .xyz or .pwn file for a .xyz or .pwn IN");
   return o;

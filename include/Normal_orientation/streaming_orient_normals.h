@@ -541,8 +541,8 @@ Streaming_result streaming_orient_files_in_input_order(const std::string& input,
   IO::Point_stream_reader reader(input);
   if (!reader.has_normals())
     throw IO::Io_error(input + ": the file has no normals (streaming needs them)");
-  const std::string in_ext = IO::internal::lower_case_extension(input);
-  const std::string out_ext = IO::internal::lower_case_extension(output);
+  const std::string in_ext = IO::lower_case_extension(input);
+  const std::string out_ext = IO::lower_case_extension(output);
   if (out_ext != ".ply" && out_ext != ".xyz" && out_ext != ".pwn")
     throw IO::Io_error(output + ": unknown point cloud file extension '" + out_ext + "' (expected .xyz, .pwn or .ply)");
   if ((in_ext == ".ply") != (out_ext == ".ply"))

@@ -51,7 +51,7 @@ public:
   {
     if (m_directory.empty())
       return;
-    const std::string e = IO::internal::lower_case_extension("f" + m_extension);
+    const std::string e = IO::lower_case_extension("f" + m_extension);
     if (e != ".ply" && e != ".xyz" && e != ".pwn")
       throw std::invalid_argument("streaming_orient_normals: unknown component file extension '" + m_extension +
                                   "' (expected .ply, .xyz or .pwn)");
@@ -59,10 +59,10 @@ public:
     if (std::filesystem::is_directory(m_directory, ec))
       return;
     if (std::filesystem::exists(m_directory, ec))
-      IO::internal::fail(m_directory, "cannot write the component files: not a directory");
+      throw IO::Io_error(m_directory + ": cannot write the component files: not a directory");
     m_created = std::filesystem::create_directories(m_directory, ec);
     if (ec)
-      IO::internal::fail(m_directory, "cannot create the directory of the component files: " + ec.message());
+      throw IO::Io_error(m_directory + ": cannot create the directory of the component files: " + ec.message());
   }
   Component_file_set(const Component_file_set&) = delete;
   Component_file_set& operator=(const Component_file_set&) = delete;

@@ -7,14 +7,13 @@
 /// Sorting a streamed point cloud along its sweep axis with bounded memory.
 ///
 /// The streaming (out-of-core) pipeline sweeps the cloud along the principal
-/// axis of largest variance.  This header provides
-/// - `Sweep_frame` and `compute_sweep_frame()`: the centroid and a right-handed
-///   orthonormal basis (axis, u, v) of the cloud, computed in one streaming pass;
-/// - `External_sorter` (and the shortcut `external_sort()`): sorts all records of
-///   a source by (key along the axis, index) with bounded memory: sorted runs
-///   written to temporary files, merged lazily by a `Sorted_run_reader`, which is
-///   itself a source;
-/// - `remove_temporary_files()`: an async-signal-safe clean-up for signal handlers.
+/// axis of largest variance, given by a `Sweep_frame` (`Sweep_frame.h`).  This
+/// header provides `External_sorter` (and the shortcut `external_sort()`): it
+/// sorts all records of a source by (key along the axis, index) with bounded
+/// memory: sorted runs written to temporary files, merged lazily by a
+/// `Sorted_run_reader`, which is itself a source.  The temporary files are
+/// reached by `remove_temporary_files()`, an async-signal-safe clean-up for
+/// signal handlers.
 ///
 /// **The Source concept.**  A source of `Point_record`s is any object `s` with
 /// - `std::size_t s.read(std::vector<Point_record>& chunk, std::size_t maximum)`:
@@ -27,393 +26,42 @@
 /// POSIX only (`mkstemp`, `pread`, `unlink`).
 
 #include <Normal_orientation/Point_record.h>
-
-#if !defined(__unix__) && !defined(__APPLE__)
-#error "Normal_orientation/streaming/external_sort.h needs POSIX (mkstemp, pread, unlink)"
-#endif
+#include <Normal_orientation/internal/Future_waiter.h>
+#include <Normal_orientation/internal/Temporary_files.h>
+#include <Normal_orientation/remove_temporary_files.h>
+#include <Normal_orientation/streaming/Sweep_frame.h>
 
 #include <algorithm>
-#include <array>
-#include <atomic>
-#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
-#include <cstring>
 #include <future>
 #include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <system_error>
 #include <utility>
 #include <vector>
 
-#include <fcntl.h>
-#include <sys/types.h>
-#include <unistd.h>
-
-#include <Normal_orientation/internal/Future_waiter.h>
-#include <Normal_orientation/internal/Temporary_files.h>
-
 namespace Normal_orientation {
 namespace streaming {
-
-// ---------------------------------------------------------------------------
-// Sweep frame
-// ---------------------------------------------------------------------------
-
-/// \ingroup PkgNormalOrientationStreaming
-/// The frame of a sweep: the centroid `c` of the cloud and a right-handed
-/// orthonormal basis (`axis`, `u`, `v`), `axis` being the principal direction of
-/// largest variance and `u` the second one.  The sweep visits the points by
-/// increasing `key(p) = dot(p - c, axis)`; `uv(p)` gives their coordinates in the
-/// plane orthogonal to the axis (for a 2-D grid).  The frame only *reads*
-/// positions: the records themselves are never moved to this frame.
-///
-/// For degenerate clouds (empty, one point, identical, collinear or planar
-/// points) the frame is still orthonormal, right-handed and deterministic; for
-/// an empty cloud it is the canonical frame at the origin.
-struct Sweep_frame
-{
-  /// the centroid of the (finite) points
-  std::array<double, 3> centroid{{0., 0., 0.}};
-  /// the sweep axis: the unit principal direction of largest variance, its
-  /// largest absolute component positive (ties: the first one)
-  std::array<double, 3> axis{{1., 0., 0.}};
-  /// the unit principal direction of second largest variance, orthogonal to
-  /// `axis`, its largest absolute component positive (ties: the first one)
-  std::array<double, 3> u{{0., 1., 0.}};
-  /// `axis` x `u`, so that (axis, u, v) is right-handed
-  std::array<double, 3> v{{0., 0., 1.}};
-  /// the variances along `axis`, `u` and `v` (eigenvalues of the population
-  /// covariance, in decreasing order)
-  std::array<double, 3> variances{{0., 0., 0.}};
-  /// the number of records read
-  std::uint64_t size = 0;
-  /// the number of records ignored because a coordinate is not finite (their
-  /// key is NaN; the sort puts them last)
-  std::uint64_t non_finite = 0;
-
-  /// the sweep key of `r`: dot(position - centroid, axis)
-  double key(const Point_record& r) const
-  {
-    const double dx = r.position[0] - centroid[0];
-    const double dy = r.position[1] - centroid[1];
-    const double dz = r.position[2] - centroid[2];
-    const double kx = dx * axis[0];
-    const double ky = dy * axis[1];
-    const double kz = dz * axis[2];
-    return (kx + ky) + kz;
-  }
-
-  /// the coordinate of `r` along `u`: dot(position - centroid, u)
-  double u_coordinate(const Point_record& r) const { return project(r, u); }
-
-  /// the coordinate of `r` along `v`: dot(position - centroid, v)
-  double v_coordinate(const Point_record& r) const { return project(r, v); }
-
-  /// the coordinates (u, v) of `r` in the plane orthogonal to the axis
-  std::array<double, 2> uv(const Point_record& r) const
-  {
-    return {{u_coordinate(r), v_coordinate(r)}};
-  }
-
-private:
-  double project(const Point_record& r, const std::array<double, 3>& d) const
-  {
-    const double dx = r.position[0] - centroid[0];
-    const double dy = r.position[1] - centroid[1];
-    const double dz = r.position[2] - centroid[2];
-    return (dx * d[0] + dy * d[1]) + dz * d[2];
-  }
-};
-
 namespace internal {
 
-/// Eigen-decomposition of a symmetric 3x3 matrix `m` by cyclic Jacobi
-/// rotations: `values[k]` is the eigenvalue of the unit eigenvector stored in
-/// column `k` of `vectors` (vectors[row][k]).  Deterministic; orthogonal output.
-inline void symmetric_eigen_3(const double (&m)[3][3], double (&values)[3], double (&vectors)[3][3])
-{
-  double a[3][3];
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j) {
-      a[i][j] = 0.5 * (m[i][j] + m[j][i]);
-      vectors[i][j] = (i == j) ? 1. : 0.;
-    }
-  static const int pairs[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-  for (int sweep = 0; sweep < 64; ++sweep) {
-    const double off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
-    const double diagonal = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
-    if (!(off > 1e-34 * diagonal)) // also stops on zero or non-finite matrices
-      break;
-    for (const auto& pq : pairs) {
-      const int p = pq[0], q = pq[1];
-      if (a[p][q] == 0.)
-        continue;
-      // rotation J (J_pp = J_qq = c, J_pq = s, J_qp = -s) with (J^T A J)_pq = 0:
-      // t = tan(phi) is the smaller root of t^2 + 2 theta t - 1 = 0
-      const double theta = (a[q][q] - a[p][p]) / (2. * a[p][q]);
-      double t;
-      if (std::abs(theta) > 1e150)
-        t = 0.5 / theta;
-      else
-        t = (theta >= 0. ? 1. : -1.) / (std::abs(theta) + std::sqrt(theta * theta + 1.));
-      const double c = 1. / std::sqrt(t * t + 1.);
-      const double s = t * c;
-      double j[3][3] = {{1., 0., 0.}, {0., 1., 0.}, {0., 0., 1.}};
-      j[p][p] = c;
-      j[q][q] = c;
-      j[p][q] = s;
-      j[q][p] = -s;
-      double aj[3][3], jtaj[3][3], vj[3][3];
-      for (int r = 0; r < 3; ++r)
-        for (int k = 0; k < 3; ++k) {
-          aj[r][k] = a[r][0] * j[0][k] + a[r][1] * j[1][k] + a[r][2] * j[2][k];
-          vj[r][k] = vectors[r][0] * j[0][k] + vectors[r][1] * j[1][k] + vectors[r][2] * j[2][k];
-        }
-      for (int r = 0; r < 3; ++r)
-        for (int k = 0; k < 3; ++k)
-          jtaj[r][k] = j[0][r] * aj[0][k] + j[1][r] * aj[1][k] + j[2][r] * aj[2][k];
-      for (int r = 0; r < 3; ++r)
-        for (int k = 0; k < 3; ++k) {
-          a[r][k] = (r == k) ? jtaj[r][k] : 0.5 * (jtaj[r][k] + jtaj[k][r]);
-          vectors[r][k] = vj[r][k];
-        }
-      a[p][q] = a[q][p] = 0.;
-    }
-  }
-  for (int k = 0; k < 3; ++k)
-    values[k] = a[k][k];
-}
-
-/// normalizes `d`; returns false if its length is zero or not finite
-inline bool normalize(std::array<double, 3>& d)
-{
-  const double length = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
-  if (!(length > 0.) || !std::isfinite(length))
-    return false;
-  for (double& x : d)
-    x /= length;
-  return true;
-}
-
-/// flips `d` so that its largest absolute component (the first one on ties) is positive
-inline void make_sign_canonical(std::array<double, 3>& d)
-{
-  int largest = 0;
-  for (int k = 1; k < 3; ++k)
-    if (std::abs(d[k]) > std::abs(d[largest]))
-      largest = k;
-  if (d[largest] < 0.)
-    for (double& x : d)
-      x = -x;
-}
-
-/// the cross product a x b
-inline std::array<double, 3> cross(const std::array<double, 3>& a, const std::array<double, 3>& b)
-{
-  return {{a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]}};
-}
-
-/// Streaming accumulator of the count, the centroid and the covariance of
-/// positions (Welford's update, numerically stable for far-from-origin clouds).
-/// Records with a non-finite coordinate are counted but otherwise ignored.
-class Moment_accumulator
-{
-public:
-  /// adds one record
-  void add(const Point_record& r)
-  {
-    ++m_size;
-    const double* p = r.position;
-    if (!(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))) {
-      ++m_non_finite;
-      return;
-    }
-    ++m_count;
-    const double n = double(m_count);
-    double delta[3], delta_after[3];
-    for (int i = 0; i < 3; ++i) {
-      delta[i] = p[i] - m_mean[i];
-      m_mean[i] += delta[i] / n;
-      delta_after[i] = p[i] - m_mean[i];
-    }
-    for (int i = 0; i < 3; ++i)
-      for (int j = i; j < 3; ++j)
-        m_m2[i][j] += delta[i] * delta_after[j];
-  }
-
-  /// the frame of the records added so far
-  Sweep_frame frame() const
-  {
-    Sweep_frame f;
-    f.size = m_size;
-    f.non_finite = m_non_finite;
-    if (m_count == 0)
-      return f;
-    for (int i = 0; i < 3; ++i)
-      f.centroid[i] = m_mean[i];
-    double covariance[3][3];
-    bool finite = true;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        covariance[i][j] = (i <= j ? m_m2[i][j] : m_m2[j][i]) / double(m_count);
-        finite = finite && std::isfinite(covariance[i][j]);
-      }
-    if (!finite) // overflow (coordinates beyond ~1e150): keep the canonical basis
-      return f;
-    double values[3], vectors[3][3];
-    symmetric_eigen_3(covariance, values, vectors);
-    int order[3] = {0, 1, 2};
-    std::stable_sort(order, order + 3, [&](int a, int b) { return values[a] > values[b]; });
-    std::array<double, 3> axis{{vectors[0][order[0]], vectors[1][order[0]], vectors[2][order[0]]}};
-    std::array<double, 3> u{{vectors[0][order[1]], vectors[1][order[1]], vectors[2][order[1]]}};
-    if (!normalize(axis))
-      return f;
-    make_sign_canonical(axis);
-    // re-orthogonalize u against the axis (Jacobi's vectors are orthogonal up to rounding)
-    const double along = u[0] * axis[0] + u[1] * axis[1] + u[2] * axis[2];
-    for (int i = 0; i < 3; ++i)
-      u[i] -= along * axis[i];
-    if (!normalize(u)) { // cannot happen with an orthogonal Jacobi output; be safe anyway
-      int smallest = 0;
-      for (int k = 1; k < 3; ++k)
-        if (std::abs(axis[k]) < std::abs(axis[smallest]))
-          smallest = k;
-      std::array<double, 3> e{{0., 0., 0.}};
-      e[smallest] = 1.;
-      u = cross(axis, e);
-      normalize(u);
-    }
-    make_sign_canonical(u);
-    f.axis = axis;
-    f.u = u;
-    f.v = cross(axis, u);
-    normalize(f.v);
-    for (int k = 0; k < 3; ++k)
-      f.variances[k] = std::max(0., values[order[k]]);
-    return f;
-  }
-
-private:
-  std::uint64_t m_size = 0;
-  std::uint64_t m_non_finite = 0;
-  std::uint64_t m_count = 0;
-  double m_mean[3] = {0., 0., 0.};
-  double m_m2[3][3] = {{0., 0., 0.}, {0., 0., 0.}, {0., 0., 0.}};
-};
-
-} // namespace internal
-
-/// \ingroup PkgNormalOrientationStreaming
-/// Computes the sweep frame of all records of `source` in one streaming pass,
-/// reading chunks of at most `chunk_records` records.  Rewinds the source
-/// before and after the pass.  Memory: one chunk.
-template <class Source>
-Sweep_frame compute_sweep_frame(Source& source, std::size_t chunk_records = 65536)
-{
-  chunk_records = std::max<std::size_t>(chunk_records, 1);
-  source.rewind();
-  internal::Moment_accumulator accumulator;
-  std::vector<Point_record> chunk;
-  chunk.reserve(chunk_records);
-  for (;;) {
-    chunk.clear();
-    const std::size_t n = source.read(chunk, chunk_records);
-    if (n == 0)
-      break;
-    if (n != chunk.size())
-      throw std::logic_error("compute_sweep_frame: the source's read() returned a wrong count");
-    for (const Point_record& r : chunk)
-      accumulator.add(r);
-  }
-  source.rewind();
-  return accumulator.frame();
-}
-
-// ---------------------------------------------------------------------------
-// Temporary files
-// ---------------------------------------------------------------------------
-
-namespace internal {
-
-using Normal_orientation::internal::register_temporary_file;
-using Normal_orientation::internal::temporary_file_path_capacity;
-using Normal_orientation::internal::temporary_file_slot_count;
-using Normal_orientation::internal::temporary_file_slots;
-using Normal_orientation::internal::unregister_temporary_file;
-
-/// writes `bytes` bytes to `fd`, throwing `std::system_error` on failure
-inline void write_all(int fd, const void* data, std::size_t bytes, const std::string& path)
-{
-  const char* p = static_cast<const char*>(data);
-  while (bytes > 0) {
-    const ::ssize_t n = ::write(fd, p, std::min<std::size_t>(bytes, std::size_t(1) << 30));
-    if (n < 0) {
-      if (errno == EINTR)
-        continue;
-      throw std::system_error(errno, std::generic_category(), "cannot write the temporary file " + path);
-    }
-    if (n == 0)
-      throw std::system_error(ENOSPC, std::generic_category(), "cannot write the temporary file " + path);
-    p += n;
-    bytes -= std::size_t(n);
-  }
-}
-
-/// A temporary record file: created with `mkstemp()` in a directory, registered
-/// for `remove_temporary_files()`, removed by the destructor (RAII).  Records
-/// are appended, then read at any position with `pread()` (no shared offset).
-class Temporary_file
+/// A run of the external sort on disk: a temporary file of `Point_record`s in
+/// the temporary directory (see `Normal_orientation::internal::Temporary_file`),
+/// appended, then read at any position (`pread()`: no shared offset).
+class Run_file
 {
 public:
   /// creates an empty file `directory`/normal_orientation_sort_XXXXXX; if
   /// `unlink_now`, removes its name at once (the data lives while the file is open)
-  Temporary_file(const std::string& directory, bool unlink_now)
-  {
-    std::string name = directory.empty() ? std::string("/tmp") : directory;
-    if (name.back() != '/')
-      name += '/';
-    name += "normal_orientation_sort_XXXXXX";
-    m_path = name; // allocated before the file exists: nothing can leak after mkstemp()
-    m_fd = ::mkstemp(&m_path[0]);
-    if (m_fd < 0)
-      throw std::system_error(errno, std::generic_category(),
-                              "external sort: cannot create a temporary file " + name);
-    if (unlink_now) {
-      ::unlink(m_path.c_str());
-      m_unlinked = true;
-    }
-    else
-      m_slot = register_temporary_file(m_path);
-  }
-
-  Temporary_file(const Temporary_file&) = delete;
-  Temporary_file& operator=(const Temporary_file&) = delete;
-
-  /// closes and removes the file
-  ~Temporary_file()
-  {
-    if (!m_unlinked) {
-      // a handler may have removed it already (state 3): then leave the name alone
-      const bool removed_by_handler =
-        m_slot >= 0 && temporary_file_slots[m_slot].state.load(std::memory_order_acquire) == 3;
-      if (!removed_by_handler)
-        ::unlink(m_path.c_str());
-      unregister_temporary_file(m_slot);
-    }
-    if (m_fd >= 0)
-      ::close(m_fd);
-  }
+  Run_file(const std::string& directory, bool unlink_now) : m_file(directory, "normal_orientation_sort_", unlink_now) {}
 
   /// appends `n` records stored as bytes at `records` (n * 56 bytes)
   void append(const void* records, std::size_t n)
   {
-    write_all(m_fd, records, n * sizeof(Point_record), m_path);
+    m_file.append(records, n * sizeof(Point_record));
     m_size += n;
   }
 
@@ -423,36 +71,18 @@ public:
     if (first >= m_size)
       return 0;
     n = std::size_t(std::min<std::uint64_t>(n, m_size - first));
-    char* p = reinterpret_cast<char*>(records);
-    std::size_t bytes = n * sizeof(Point_record);
-    std::uint64_t offset = first * sizeof(Point_record);
-    while (bytes > 0) {
-      const ::ssize_t got = ::pread(m_fd, p, bytes, ::off_t(offset));
-      if (got < 0) {
-        if (errno == EINTR)
-          continue;
-        throw std::system_error(errno, std::generic_category(), "external sort: cannot read " + m_path);
-      }
-      if (got == 0)
-        throw std::runtime_error("external sort: " + m_path + " is shorter than written");
-      p += got;
-      bytes -= std::size_t(got);
-      offset += std::uint64_t(got);
-    }
+    m_file.read(records, n * sizeof(Point_record), first * sizeof(Point_record));
     return n;
   }
 
   /// the number of records written
   std::uint64_t size() const { return m_size; }
   /// the path of the file
-  const std::string& path() const { return m_path; }
+  const std::string& path() const { return m_file.path(); }
 
 private:
-  int m_fd = -1;
-  int m_slot = -1;
-  bool m_unlinked = false;
+  Normal_orientation::internal::Temporary_file m_file;
   std::uint64_t m_size = 0;
-  std::string m_path;
 };
 
 /// the sort order: by key (NaN keys last, all equal), then by index.  A strict
@@ -514,7 +144,7 @@ struct Sort_run
     });
   }
   /// writes the records in the order of the sorted tags
-  void write(Temporary_file& file) const
+  void write(Run_file& file) const
   {
     const std::size_t block = 8192;
     std::vector<Point_record> buffer(std::min(block, tags.size()));
@@ -570,7 +200,7 @@ class Run_merger
 public:
   /// merges `runs` (not owned; they must outlive the merger), buffering up to
   /// `buffer_records` records of each run
-  Run_merger(std::vector<const Temporary_file*> runs, const Sweep_frame& frame, std::size_t buffer_records)
+  Run_merger(std::vector<const Run_file*> runs, const Sweep_frame& frame, std::size_t buffer_records)
     : m_frame(frame), m_buffer_records(std::max<std::size_t>(buffer_records, 1))
   {
     m_cursors.resize(runs.size());
@@ -616,7 +246,7 @@ private:
   /// a run being read: its file, a buffer of its next records and where they come from
   struct Cursor
   {
-    const Temporary_file* file = nullptr;
+    const Run_file* file = nullptr;
     std::vector<Point_record> buffer;
     std::size_t position = 0;
     std::uint64_t next_record = 0;
@@ -669,22 +299,11 @@ private:
 };
 
 /// the temporary directory: `requested` if not empty, else `$TMPDIR` if set and
-/// not empty, else /tmp
-inline std::string temporary_directory(const std::string& requested)
-{
-  if (!requested.empty())
-    return requested;
-  const char* tmpdir = std::getenv("TMPDIR");
-  if (tmpdir != nullptr && tmpdir[0] != '\0')
-    return tmpdir;
-  return "/tmp";
-}
-
 } // namespace internal
 
 /// \ingroup PkgNormalOrientationStreaming
 /// See `Normal_orientation::remove_temporary_files()` (in
-/// `internal/Temporary_files.h`): also reaches the sort's files.
+/// `remove_temporary_files.h`): also reaches the sort's files.
 using Normal_orientation::remove_temporary_files;
 
 // ---------------------------------------------------------------------------
@@ -794,7 +413,7 @@ private:
   External_sort_report m_report;
   std::vector<Point_record> m_memory; // the single run, sorted, when it fits in memory
   std::size_t m_memory_position = 0;
-  std::vector<std::unique_ptr<internal::Temporary_file>> m_runs;
+  std::vector<std::unique_ptr<internal::Run_file>> m_runs;
   std::unique_ptr<internal::Run_merger> m_merger; // after m_runs: destroyed first
 };
 
@@ -835,7 +454,7 @@ public:
     Sorted_run_reader result;
     result.m_frame = frame;
     External_sort_report& report = result.m_report;
-    report.temporary_directory = internal::temporary_directory(m_options.temporary_directory);
+    report.temporary_directory = Normal_orientation::internal::temporary_directory(m_options.temporary_directory);
 
     const std::size_t run_capacity = std::min<std::size_t>(
       std::max<std::size_t>(m_options.memory_budget / External_sort_options::bytes_per_record, 16),
@@ -852,7 +471,7 @@ public:
     std::vector<Level_run> runs; // the files; touched by one flush at a time
     auto flush = [&](internal::Sort_run& run) {
       run.sort();
-      auto file = std::make_unique<internal::Temporary_file>(report.temporary_directory,
+      auto file = std::make_unique<internal::Run_file>(report.temporary_directory,
                                                              m_options.unlink_on_creation);
       run.write(*file);
       report.bytes_written += file->size() * sizeof(Point_record);
@@ -902,7 +521,7 @@ public:
         flush(*filling);
       filling->release();
       collapse(runs, fan_in, 1, frame, report, m_options.memory_budget); // at most fan_in runs for the reader
-      std::vector<const internal::Temporary_file*> files;
+      std::vector<const internal::Run_file*> files;
       for (Level_run& r : runs) {
         files.push_back(r.file.get());
         result.m_runs.push_back(std::move(r.file));
@@ -919,7 +538,7 @@ private:
   /// a run file and its merge level (0: written from memory)
   struct Level_run
   {
-    std::unique_ptr<internal::Temporary_file> file;
+    std::unique_ptr<internal::Run_file> file;
     std::size_t level;
   };
 
@@ -951,13 +570,13 @@ private:
       else if (runs.size() <= fan_in)
         return;
       const std::size_t first = runs.size() - fan_in;
-      std::vector<const internal::Temporary_file*> files;
+      std::vector<const internal::Run_file*> files;
       std::size_t level = 0;
       for (std::size_t i = first; i < runs.size(); ++i) {
         files.push_back(runs[i].file.get());
         level = std::max(level, runs[i].level);
       }
-      auto merged = std::make_unique<internal::Temporary_file>(report.temporary_directory,
+      auto merged = std::make_unique<internal::Run_file>(report.temporary_directory,
                                                                m_options.unlink_on_creation);
       {
         const std::size_t chunk = merge_buffer_records(fan_in + 1, budget);
