@@ -144,11 +144,12 @@ void estimate_normals_if_needed(NO::IO::Point_cloud& cloud, Range& range, const 
   if (!run.normals_estimated())
     return;
   const auto t = Clock::now();
+  if (cloud.size() < 4)
+    throw std::runtime_error(o.input + (cloud.has_normals() ? ": all normals are zero, and too few points to estimate them"
+                                                            : ": too few points to estimate normals"));
   if (cloud.has_normals() && !o.quiet)
     std::fprintf(stderr, "%s: all %zu normals are zero: estimating them (%s), as for a file without normals\n",
                  o.input.c_str(), cloud.size(), o.normals.c_str());
-  if (cloud.size() < 4)
-    throw std::runtime_error(o.input + ": too few points to estimate normals");
   cloud.normals.assign(cloud.size(), {0.0, 0.0, 0.0});
   cloud.normal_digits = 0; // computed values: written with as many digits as they need
   const unsigned nk = unsigned(std::min<std::size_t>(o.normal_k, cloud.size() - 1));

@@ -295,6 +295,49 @@ awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/bare.xyz"
 expect_exit 0 "estimates missing normals" "$prog" --quiet --normals pca "$dir/bare.xyz" "$dir/bare_out.xyz"
 check "estimated normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/bare_out.xyz"
 
+# a placeholder is not a normal: a file whose normals are all zero is oriented
+# as the same file without normals is (jet or --normals pca), and says so on
+# stderr and in the JSON; a file with some zero normals leaves those points as
+# they were and says how many; --stream refuses an all-zero file (one line, no
+# output, no temporary file)
+awk '{ print $1, $2, $3, 0, 0, 0 }' "$dir/sphere.xyz" > "$dir/zero.xyz"
+expect_exit 0 "no normals, jet" "$prog" --quiet --json "$dir/bare.xyz" "$dir/bare_jet.xyz"
+check "no normals: the JSON says why they were estimated" \
+  grep -q '"normals_estimated": true, "normals_estimated_because": "the input has no normals"' "$dir/out.txt"
+expect_exit 0 "all-zero normals" "$prog" --json "$dir/zero.xyz" "$dir/zero_jet.xyz"
+check "all-zero normals: oriented as the file without normals (jet)" cmp -s "$dir/bare_jet.xyz" "$dir/zero_jet.xyz"
+check "all-zero normals: said on stderr" grep -q "zero.xyz: all 600 normals are zero: estimating them (jet)" "$dir/err.txt"
+check "all-zero normals: the JSON says they were estimated and why" \
+  grep -q '"normals_estimated": true, "normals_estimated_because": "all input normals are zero"' "$dir/out.txt"
+check "all-zero normals: one component" grep -q '"components": 1,' "$dir/out.txt"
+expect_exit 0 "all-zero normals, pca" "$prog" --quiet --normals pca "$dir/zero.xyz" "$dir/zero_pca.xyz"
+check "all-zero normals: oriented as the file without normals (pca)" cmp -s "$dir/bare_out.xyz" "$dir/zero_pca.xyz"
+check "all-zero normals, --quiet: nothing on stderr" test ! -s "$dir/err.txt"
+awk '{ if (NR % 50 == 0) print $1, $2, $3, 0, 0, 0; else print }' "$dir/sphere.xyz" > "$dir/some_zero.xyz"
+expect_exit 0 "some zero normals" "$prog" --json "$dir/some_zero.xyz" "$dir/some_zero_out.xyz"
+check "some zero normals: the JSON counts them" grep -q '"zero_normals": 12,' "$dir/out.txt"
+check "some zero normals: not estimated" grep -q '"normals_estimated": false,' "$dir/out.txt"
+check "some zero normals: stderr counts them" grep -q "^12 of 600 points have a zero normal: left as they were$" \
+  "$dir/err.txt"
+check "some zero normals: those points left as they were, the others outward" awk '
+  { if (NR % 50 == 0) { if ($4 != 0 || $5 != 0 || $6 != 0) bad++ } else if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ }
+  END { exit (bad > 0 || NR != 600) }' "$dir/some_zero_out.xyz"
+expect_exit 0 "no zero normal: no count on stderr" "$prog" "$dir/sphere.xyz" "$dir/none_zero.xyz"
+check "no zero normal: no count on stderr" test -z "$(grep "zero normal" "$dir/err.txt")"
+expect_exit 1 "stream refuses all-zero normals" "$prog" --quiet --stream "$dir/zero.xyz" "$dir/zero_stream.xyz"
+check "stream, all-zero normals: one-line error" test "$(wc -l < "$dir/err.txt")" -eq 1
+check "stream, all-zero normals: the error says to run in core" \
+  grep -q "^orient_normals: error: .*zero.xyz: every normal is zero.*run without --stream" "$dir/err.txt"
+check "stream, all-zero normals: no output" test -z "$(find "$dir" -name 'zero_stream.xyz*')"
+check "stream, all-zero normals: no temporary file" test -z "$(ls -A "$dir/tmp")"
+expect_exit 0 "stream, some zero normals" "$prog" --quiet --stream "$dir/some_zero.xyz" "$dir/some_zero_stream.xyz"
+head -3 "$dir/zero.xyz" > "$dir/zero3.xyz"
+expect_exit 1 "all-zero normals, too few points to estimate them" "$prog" "$dir/zero3.xyz" "$dir/zero3_out.xyz"
+check "all-zero normals, too few points: one-line error" test "$(wc -l < "$dir/err.txt")" -eq 1
+check "all-zero normals, too few points: the error says why" grep -q "all normals are zero, and too few points" \
+  "$dir/err.txt"
+check "all-zero normals, too few points: no output" test -z "$(find "$dir" -name 'zero3_out.xyz*')"
+
 # --keep-order: OUT is IN itself, in its order and with its text, only the
 # signs of the normals changed, and the same signs as the sweep-order output
 expect_exit 0 "stream --keep-order" "$prog" --quiet --json --stream --keep-order "$dir/sphere.xyz" "$dir/kept.xyz"
