@@ -64,6 +64,10 @@ int main(int argc, char** argv)
       reader, sink,
       NO::parameters::presorted_axis(presorted).flip_criterion(NO::Hoppe_criterion()).callback(progress));
     std::cerr << (stage < 0 ? "" : "\n");
+    if (r.interrupted) {
+      std::cerr << "stream_ply_file: interrupted\n";
+      return 1; // the writer is not committed: no OUT
+    }
     if (r.number_of_points == 0) {
       std::cerr << "stream_ply_file: " << argv[1] << " holds no point\n";
       return 1; // the writer is not committed: no OUT

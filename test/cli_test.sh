@@ -121,7 +121,18 @@ expect_exit 0 "stream reads its own ply" "$prog" --quiet --stream --solver mst "
 awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/nonormals.xyz"
 expect_exit 1 "stream needs normals" "$prog" --quiet --stream "$dir/nonormals.xyz" "$dir/none.xyz"
 check "no output after a failed stream" test ! -e "$dir/none.xyz"
-expect_exit 2 "stream refuses --viewpoint" "$prog" --quiet --stream --viewpoint 0,0,0 "$dir/sphere.xyz" "$dir/none.xyz"
+# --viewpoint, --sign keep and --prior-weight work with --stream as in core:
+# the sphere's centre as the viewpoint turns every normal inward, in both
+inward() { awk '{ if ($1 * $4 + $2 * $5 + $3 * $6 >= 0) bad++; c++ } END { exit (bad > 0 || c != 600) }' "$1"; }
+expect_exit 0 "stream with a viewpoint" "$prog" --quiet --stream --viewpoint 0,0,0 "$dir/sphere.xyz" "$dir/sv.xyz"
+check "stream with a viewpoint: every normal faces it" inward "$dir/sv.xyz"
+expect_exit 0 "in core with a viewpoint" "$prog" --quiet --viewpoint 0,0,0 "$dir/sphere.xyz" "$dir/cv.xyz"
+check "in core with a viewpoint: every normal faces it" inward "$dir/cv.xyz"
+expect_exit 0 "stream with a viewpoint prior" "$prog" --quiet --json --stream --viewpoint 0,0,0 --prior-weight 0.5 "$dir/sphere.xyz" "$dir/sp.xyz"
+check "stream with a viewpoint prior: every normal faces it" inward "$dir/sp.xyz"
+check "stream with a prior: unary terms reported" grep -q '"unary_terms": 600' "$dir/out.txt"
+expect_exit 0 "stream --sign keep" "$prog" --quiet --json --stream --sign keep "$dir/sphere.xyz" "$dir/sk.xyz"
+check "stream --sign keep: reported" grep -q '"component_sign": "keep"' "$dir/out.txt"
 check "no temporary files left in TMPDIR" test -z "$(ls -A "$dir/tmp" 2>/dev/null)"
 # no progress line when stderr is not a terminal
 expect_exit 0 "stream, not quiet" "$prog" --json --stream "$dir/sphere.xyz" "$dir/loud.xyz"
@@ -295,6 +306,49 @@ awk '{ print $1, $2, $3 }' "$dir/sphere.xyz" > "$dir/bare.xyz"
 expect_exit 0 "estimates missing normals" "$prog" --quiet --normals pca "$dir/bare.xyz" "$dir/bare_out.xyz"
 check "estimated normals point outward" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' "$dir/bare_out.xyz"
 
+# a placeholder is not a normal: a file whose normals are all zero is oriented
+# as the same file without normals is (jet or --normals pca), and says so on
+# stderr and in the JSON; a file with some zero normals leaves those points as
+# they were and says how many; --stream refuses an all-zero file (one line, no
+# output, no temporary file)
+awk '{ print $1, $2, $3, 0, 0, 0 }' "$dir/sphere.xyz" > "$dir/zero.xyz"
+expect_exit 0 "no normals, jet" "$prog" --quiet --json "$dir/bare.xyz" "$dir/bare_jet.xyz"
+check "no normals: the JSON says why they were estimated" \
+  grep -q '"normals_estimated": true, "normals_estimated_because": "the input has no normals"' "$dir/out.txt"
+expect_exit 0 "all-zero normals" "$prog" --json "$dir/zero.xyz" "$dir/zero_jet.xyz"
+check "all-zero normals: oriented as the file without normals (jet)" cmp -s "$dir/bare_jet.xyz" "$dir/zero_jet.xyz"
+check "all-zero normals: said on stderr" grep -q "zero.xyz: all 600 normals are zero: estimating them (jet)" "$dir/err.txt"
+check "all-zero normals: the JSON says they were estimated and why" \
+  grep -q '"normals_estimated": true, "normals_estimated_because": "all input normals are zero"' "$dir/out.txt"
+check "all-zero normals: one component" grep -q '"components": 1,' "$dir/out.txt"
+expect_exit 0 "all-zero normals, pca" "$prog" --quiet --normals pca "$dir/zero.xyz" "$dir/zero_pca.xyz"
+check "all-zero normals: oriented as the file without normals (pca)" cmp -s "$dir/bare_out.xyz" "$dir/zero_pca.xyz"
+check "all-zero normals, --quiet: nothing on stderr" test ! -s "$dir/err.txt"
+awk '{ if (NR % 50 == 0) print $1, $2, $3, 0, 0, 0; else print }' "$dir/sphere.xyz" > "$dir/some_zero.xyz"
+expect_exit 0 "some zero normals" "$prog" --json "$dir/some_zero.xyz" "$dir/some_zero_out.xyz"
+check "some zero normals: the JSON counts them" grep -q '"zero_normals": 12,' "$dir/out.txt"
+check "some zero normals: not estimated" grep -q '"normals_estimated": false,' "$dir/out.txt"
+check "some zero normals: stderr counts them" grep -q "^12 of 600 points have a zero normal: left as they were$" \
+  "$dir/err.txt"
+check "some zero normals: those points left as they were, the others outward" awk '
+  { if (NR % 50 == 0) { if ($4 != 0 || $5 != 0 || $6 != 0) bad++ } else if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ }
+  END { exit (bad > 0 || NR != 600) }' "$dir/some_zero_out.xyz"
+expect_exit 0 "no zero normal: no count on stderr" "$prog" "$dir/sphere.xyz" "$dir/none_zero.xyz"
+check "no zero normal: no count on stderr" test -z "$(grep "zero normal" "$dir/err.txt")"
+expect_exit 1 "stream refuses all-zero normals" "$prog" --quiet --stream "$dir/zero.xyz" "$dir/zero_stream.xyz"
+check "stream, all-zero normals: one-line error" test "$(wc -l < "$dir/err.txt")" -eq 1
+check "stream, all-zero normals: the error says to run in core" \
+  grep -q "^orient_normals: error: .*zero.xyz: every normal is zero.*run without --stream" "$dir/err.txt"
+check "stream, all-zero normals: no output" test -z "$(find "$dir" -name 'zero_stream.xyz*')"
+check "stream, all-zero normals: no temporary file" test -z "$(ls -A "$dir/tmp")"
+expect_exit 0 "stream, some zero normals" "$prog" --quiet --stream "$dir/some_zero.xyz" "$dir/some_zero_stream.xyz"
+head -3 "$dir/zero.xyz" > "$dir/zero3.xyz"
+expect_exit 1 "all-zero normals, too few points to estimate them" "$prog" "$dir/zero3.xyz" "$dir/zero3_out.xyz"
+check "all-zero normals, too few points: one-line error" test "$(wc -l < "$dir/err.txt")" -eq 1
+check "all-zero normals, too few points: the error says why" grep -q "all normals are zero, and too few points" \
+  "$dir/err.txt"
+check "all-zero normals, too few points: no output" test -z "$(find "$dir" -name 'zero3_out.xyz*')"
+
 # --keep-order: OUT is IN itself, in its order and with its text, only the
 # signs of the normals changed, and the same signs as the sweep-order output
 expect_exit 0 "stream --keep-order" "$prog" --quiet --json --stream --keep-order "$dir/sphere.xyz" "$dir/kept.xyz"
@@ -317,7 +371,7 @@ for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--or
     "--stream --min-component-size -1" "--stream --min-component-size x" "--write-segments" \
     "--stream --write-segments" "--batch-size 10" "--stream --batch-size 0" "--stream --batch-size x" \
     "--keep-order" "--stream --keep-order --ascii" "--stream --keep-order --write-segments" "--refine 1" \
-    "--stream --refine 17" "--stream --refine x"; do
+    "--stream --refine 65" "--stream --refine x"; do
   # shellcheck disable=SC2086
   expect_exit 2 "bad option $args" "$prog" $args "$dir/sphere.xyz" "$dir/bad_opt.xyz"
   check "one-line error for $args" test "$(wc -l < "$dir/err.txt")" -eq 1

@@ -653,6 +653,8 @@ TEST(Streaming_sweep, RefusesUnsortedInput)
 
 #include "Streaming_test_options.h"
 
+#include <boost/property_map/function_property_map.hpp>
+
 namespace {
 
 using NO::test::Stream_options;
@@ -749,4 +751,79 @@ TEST(Streaming_orient_normals, AgreesWithInCoreAndFacesOutward)
       wrong2 += (Vector(r.normal[0], r.normal[1], r.normal[2]) * c.truth[r.index].n <= 0.0) ? 1 : 0;
     EXPECT_LE(wrong2, input.size() / 200);
   }
+}
+
+// The sign policies and unary terms in both drivers: with the sphere's centre
+// as viewpoint every normal faces inward, streamed as in core, with and
+// without a viewpoint prior (unary terms on the segment graph); the
+// constrained fallback keeps the constrained points' sign; keep leaves the
+// solver's labelling, whose normals are consistent.
+TEST(Streaming_orient_normals, SignPoliciesAndPriorsAsInCore)
+{
+  std::mt19937_64 rng(47);
+  const auto truth = sphere(12000, rng);
+  const auto input = unoriented(truth, rng, 0.1);
+  const NO::Viewpoint_component_sign centre(0, 0, 0);
+  auto inward_count = [&](const std::vector<NO::Point_record>& out) {
+    std::size_t inward = 0;
+    for (const auto& r : out)
+      inward += (Vector(r.normal[0], r.normal[1], r.normal[2]) * truth[r.index].n < 0.0) ? 1 : 0;
+    return inward;
+  };
+  auto streamed = [&](const auto& np, NO::Streaming_result& result) {
+    Rewindable_source src{as_records(input)};
+    std::vector<NO::Point_record> out;
+    auto sink = [&](const NO::Point_record& r) { out.push_back(r); };
+    result = NO::streaming_orient_normals(src, sink, np);
+    return out;
+  };
+  // a prior of weight 0.5 towards the centre, by input index (streamed) and by element (in core)
+  std::vector<double> prior(input.size());
+  for (std::size_t i = 0; i < input.size(); ++i) {
+    const Vector to = Point(0, 0, 0) - input[i].first;
+    prior[i] = 0.5 * (to * input[i].second) / std::sqrt(to.squared_length() * input[i].second.squared_length());
+  }
+  auto record_prior =
+    boost::make_function_property_map<NO::Point_record>([&](const NO::Point_record& r) { return prior[r.index]; });
+
+  NO::Streaming_result sv, sp, sk, sc;
+  const auto viewpoint = streamed(NO::parameters::component_sign(centre), sv);
+  EXPECT_EQ(inward_count(viewpoint), input.size());
+  EXPECT_EQ(sv.component_sign, "viewpoint");
+  EXPECT_EQ(sv.number_of_unary_terms, 0u);
+  auto in_core = input;
+  const auto ic = NO::orient_normals(in_core, pn_params().component_sign(centre));
+  EXPECT_EQ(count_wrong(truth, in_core), input.size()); // every normal inward in core too
+  EXPECT_EQ(ic.component_sign, sv.component_sign);
+
+  const auto with_prior = streamed(NO::parameters::component_sign(centre).orientation_prior_map(record_prior), sp);
+  EXPECT_EQ(inward_count(with_prior), input.size());
+  EXPECT_EQ(sp.number_of_unary_terms, input.size());
+  EXPECT_EQ(sp.refinement_rounds_accepted, 0u); // no refinement with unary terms
+  auto in_core_prior = input;
+  const auto icp = NO::orient_normals(
+    in_core_prior, pn_params().component_sign(centre).orientation_prior_map(Prior_map{in_core_prior.data(), &prior}));
+  EXPECT_EQ(count_wrong(truth, in_core_prior), input.size());
+  EXPECT_EQ(icp.number_of_unary_terms, sp.number_of_unary_terms);
+
+  // keep: consistent, either sign
+  const auto kept = streamed(NO::parameters::component_sign(NO::Keep_component_sign()), sk);
+  const std::size_t k_in = inward_count(kept);
+  EXPECT_TRUE(k_in == 0 || k_in == input.size()) << k_in;
+  EXPECT_EQ(sk.component_sign, "keep");
+
+  // constraints: ten points whose input normal is inward fix the sign of the sphere
+  std::vector<char> fixed(input.size(), 0);
+  std::size_t n_fixed = 0;
+  for (std::size_t i = 0; i < input.size() && n_fixed < 10; ++i)
+    if (input[i].second * truth[i].n < 0.0) {
+      fixed[i] = 1;
+      ++n_fixed;
+    }
+  auto record_fixed =
+    boost::make_function_property_map<NO::Point_record>([&](const NO::Point_record& r) { return fixed[r.index] != 0; });
+  const auto constrained = streamed(NO::parameters::point_is_constrained_map(record_fixed), sc);
+  EXPECT_EQ(inward_count(constrained), input.size());
+  EXPECT_EQ(sc.component_sign, "constrained");
+  EXPECT_EQ(sc.number_of_unary_terms, 10u);
 }

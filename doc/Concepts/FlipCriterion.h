@@ -27,8 +27,11 @@ A model must be
 - finite on degenerate input: normals of any length, zero normals (return 0) and
   coincident points;
 - thread safe: `operator()` is `const` and is called concurrently on different edges;
-- copy constructible (it is stored by value), and default constructible for
-  `Normal_orientation::streaming_orient_normals()`, which has a default criterion argument.
+- copy constructible (it is stored by value in the named-parameter pack).
+
+Both drivers call the same `operator()`: `Normal_orientation::orient_normals()` on the edges
+of the in-core graph, `Normal_orientation::streaming_orient_normals()` on the edges the sweep
+finds.
 
 \cgalHasModelsBegin
 \cgalHasModels{Normal_orientation::Hoppe_criterion}
@@ -36,8 +39,8 @@ A model must be
 \cgalHasModels{Normal_orientation::Konig_criterion}
 \cgalHasModelsEnd
 
-\sa the named parameter `flip_criterion` of `Normal_orientation::orient_normals()`
-    (\ref NormalOrientationNamedParameters)
+\sa the named parameter `flip_criterion` of `Normal_orientation::orient_normals()` and
+    `Normal_orientation::streaming_orient_normals()` (\ref NormalOrientationNamedParameters)
 \sa `Normal_orientation::build_neighbor_graph()`
 */
 class FlipCriterion
@@ -54,8 +57,9 @@ public:
   template <typename Point_3, typename Vector_3>
   double operator()(const Point_3& p_i, const Vector_3& n_i, const Point_3& p_j, const Vector_3& n_j) const;
 
-  /// Optional: the name of the criterion, reported in `Normal_orientation::Orientation_result::criterion`
-  /// ("user" when the model has no such function).
+  /// Optional: the name of the criterion, reported in
+  /// `Normal_orientation::Orientation_summary::criterion` of both drivers' results ("user"
+  /// when the model has no such function; a non-static member function does too).
   /// \return a string literal, such as "hoppe"
   static const char* name();
 };

@@ -33,11 +33,13 @@ terms): a solver may return either sign, and a `ComponentSignPolicy` decides aft
 Solvers must be deterministic (random choices come from a seed held by the solver) and
 `solve()` is `const`.
 
-The overload with unary terms is optional: `Normal_orientation::orient_normals()` needs it
-only when the named parameters `point_is_constrained_map` or `orientation_prior_map` are
-given, and refuses, at compile time, a solver without it in that case.
-`Normal_orientation::streaming_orient_normals()` calls the overload without unary terms
-on the segment graph.
+The overload with unary terms is optional: both drivers need it only when the named
+parameters `point_is_constrained_map` or `orientation_prior_map` are given.
+`Normal_orientation::orient_normals()` refuses, at compile time, a solver without it in that
+case; `Normal_orientation::streaming_orient_normals()`, which solves the segment graph (with
+the unary terms of the points summed per segment), throws `std::invalid_argument`.  Without
+unary terms, the streaming driver calls the overload without them, on the segment graph and
+in each round of its refinement.
 
 \cgalHasModelsBegin
 \cgalHasModels{Normal_orientation::Mst_solver}
@@ -46,8 +48,8 @@ on the segment graph.
 \cgalHasModels{Normal_orientation::Exhaustive_solver}
 \cgalHasModelsEnd
 
-\sa the named parameter `solver` of `Normal_orientation::orient_normals()`
-    (\ref NormalOrientationNamedParameters)
+\sa the named parameter `solver` of `Normal_orientation::orient_normals()` and
+    `Normal_orientation::streaming_orient_normals()` (\ref NormalOrientationNamedParameters)
 \sa `Normal_orientation::energy()`, `Normal_orientation::connected_components()`
 */
 class OrientationSolver
@@ -76,8 +78,9 @@ public:
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Normal_orientation::Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const;
 
-  /// Optional: the name of the solver, reported in `Normal_orientation::Orientation_result::solver`
-  /// ("user" when the model has no such function).
+  /// Optional: the name of the solver, reported in
+  /// `Normal_orientation::Orientation_summary::solver` of both drivers' results ("user" when
+  /// the model has no such function; a non-static member function does too).
   /// \return a string literal, such as "qpbo-i"
   static const char* name();
 };

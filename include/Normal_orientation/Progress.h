@@ -23,7 +23,7 @@ namespace Normal_orientation {
 
 /// \ingroup PkgNormalOrientationRef
 /// The stages of both drivers, in the order they run (each driver runs
-/// some of them: in core `INPUT`, `GRAPH`, `SOLVE`, `SIGN`, `OUTPUT`;
+/// some of them: in core `INPUT`, `GRAPH`, `SOLVE`, `SIGN`;
 /// streamed `SCAN` to `COMPONENTS`).
 enum class Stage
 {

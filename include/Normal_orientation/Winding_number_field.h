@@ -8,7 +8,7 @@
 /// 2018), evaluated by a Barnes-Hut treecode, and the point areas it needs.
 
 #include <Normal_orientation/Neighbor_graph.h>
-#include <Normal_orientation/internal/Progress.h>
+#include <Normal_orientation/Progress.h>
 #include <Normal_orientation/internal/Winding_number_tree.h>
 
 #include <CGAL/Kernel_traits.h>
@@ -24,12 +24,6 @@
 #include <vector>
 
 namespace Normal_orientation {
-
-/// \defgroup PkgNormalOrientationGlobal Global Consistency
-/// \ingroup PkgNormalOrientationRef
-/// The winding-number field of an oriented cloud, which tells inside from outside
-/// globally: `Normal_orientation::Winding_number_field` and
-/// `Normal_orientation::estimate_point_areas()`.
 
 /// \ingroup PkgNormalOrientationGlobal
 /// The default number of neighbours of `estimate_point_areas()`.
@@ -154,7 +148,7 @@ std::vector<double> estimate_point_areas(const std::vector<Point>& points, const
     sorted[s] = points[order[s]];
   std::vector<std::uint32_t> nb;
   std::vector<float> d2;
-  internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(sorted, k, nb, d2, internal::Progress(), 0.0, 1.0);
+  internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(sorted, k, nb, d2, Progress_reporter(), 0.0, 1.0);
   std::vector<float>().swap(d2);
   for (std::uint32_t& j : nb)
     j = order[j];

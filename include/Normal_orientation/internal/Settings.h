@@ -76,7 +76,7 @@ Settings read_settings(const NamedParameters& np, const char* caller)
 template <typename T, typename = void>
 struct Has_name : std::false_type {};
 template <typename T>
-struct Has_name<T, std::void_t<decltype(T::name())>> : std::true_type {};
+struct Has_name<T, std::void_t<decltype(std::declval<const T&>().name())>> : std::true_type {};
 
 /// true when `Solver` has the 4-argument solve(graph, weight, unary, labels)
 template <typename Solver, typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap, typename = void>
@@ -88,10 +88,10 @@ struct Accepts_unary<Solver, Graph, WeightMap, UnaryMap, LabelMap,
                        std::declval<LabelMap>()))>> : std::true_type {};
 
 template <typename T>
-std::string name_of(const T&)
+std::string name_of(const T& t)
 {
   if constexpr (Has_name<T>::value)
-    return T::name();
+    return t.name();
   else
     return "user";
 }

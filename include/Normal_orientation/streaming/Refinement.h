@@ -50,7 +50,7 @@ struct Earlier_edge
 
 /// \ingroup PkgNormalOrientationStreaming
 /// The parameters of the refinement of `streaming_orient_normals()` (see
-/// `Streaming_options::refinement`).
+/// the named parameter `refinement_rounds`).
 ///
 /// Each round is one pass over the points in the sweep order and one solve:
 /// the pass moves single points (a point flips when its edges weigh more

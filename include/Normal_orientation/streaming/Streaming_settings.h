@@ -59,6 +59,14 @@ struct Component_files_options
   std::size_t maximum_open_files = 32;
 };
 
+/// \ingroup PkgNormalOrientationStreaming
+/// the most rounds of refinement that `refinement_rounds` accepts
+constexpr unsigned int maximum_refinement_rounds = 64;
+
+/// \ingroup PkgNormalOrientationStreaming
+/// the points finalised per batch of the sweep when `batch_size` is not given
+constexpr std::size_t default_batch_size = std::size_t(1) << 18;
+
 /// \cond SKIP_IN_MANUAL
 namespace streaming {
 namespace internal {
@@ -73,7 +81,7 @@ struct Streaming_settings : Normal_orientation::internal::Settings
   Segmentation_thresholds thresholds;
   std::uint64_t minimum_component_size = 0;
   Component_files_options component_files;
-  std::size_t batch_size = std::size_t(1) << 18;
+  std::size_t batch_size = default_batch_size;
 };
 
 /// Reads and checks the named parameters of `streaming_orient_normals()`
@@ -96,8 +104,9 @@ Streaming_settings read_streaming_settings(const NamedParameters& np, const char
     std::uint64_t(choose_parameter(get_parameter(np, inp::minimum_component_size), std::uint64_t(0)));
   s.component_files = choose_parameter(get_parameter(np, inp::component_files), Component_files_options());
   const long long batch = (long long)(choose_parameter(get_parameter(np, inp::batch_size), s.batch_size));
-  if (rounds < 0 || rounds > 64)
-    throw std::invalid_argument(std::string(caller) + ": refinement_rounds must be between 0 and 64");
+  if (rounds < 0 || rounds > (long long)(maximum_refinement_rounds))
+    throw std::invalid_argument(std::string(caller) + ": refinement_rounds must be between 0 and " +
+                                std::to_string(maximum_refinement_rounds));
   s.refinement.rounds = unsigned(rounds);
   if (batch < 1)
     throw std::invalid_argument(std::string(caller) + ": batch_size must be at least 1");
