@@ -55,11 +55,14 @@ for cloud in "${clouds[@]}"; do
     else
       in=$cloud
     fi
+    ext=ply
+    [[ $a == *keep-order* ]] && ext=${in##*.} # a copy in the input's own format
+    rm -f "$work/old.$ext" "$work/new.$ext"
     # shellcheck disable=SC2086
-    "$old/examples/orient_normals" --quiet $a "$in" "$work/old.ply" > /dev/null 2>&1 || echo "(old failed)" > "$work/old.ply"
+    "$old/examples/orient_normals" --quiet $a "$in" "$work/old.$ext" > /dev/null 2>&1 || echo "(failed: $?)" > "$work/old.$ext"
     # shellcheck disable=SC2086
-    "$new/examples/orient_normals" --quiet $a "$in" "$work/new.ply" > /dev/null 2>&1 || echo "(new failed)" > "$work/new.ply"
-    if cmp -s "$work/old.ply" "$work/new.ply"; then
+    "$new/examples/orient_normals" --quiet $a "$in" "$work/new.$ext" > /dev/null 2>&1 || echo "(failed: $?)" > "$work/new.$ext"
+    if cmp -s "$work/old.$ext" "$work/new.$ext"; then
       passed=$((passed + 1)); echo "same      $(basename "$cloud") [$a]"
     else
       failed=$((failed + 1)); echo "DIFFERENT $(basename "$cloud") [$a]"
