@@ -40,6 +40,158 @@
 namespace Normal_orientation {
 
 
+/// \cond SKIP_IN_MANUAL
+namespace internal {
+
+/// The in-core copy of the input: positions, unit normals (zero where the
+/// input normal is zero), and the constraints and priors when given.
+template <typename Kernel>
+struct Core_points
+{
+  std::vector<typename Kernel::Point_3> points;
+  std::vector<typename Kernel::Vector_3> normals;
+  std::vector<char> constrained; ///< empty without constraints
+  std::vector<double> prior;     ///< empty without priors
+};
+
+/// Copies and checks the input (`std::invalid_argument` naming the point
+/// for a non-finite coordinate, normal or prior); counts the zero normals.
+template <typename Kernel, typename PointRange, typename PointMap, typename NormalMap, typename NamedParameters,
+          bool HasConstraints, bool HasPrior>
+void copy_input(PointRange& points, const PointMap& point_map, const NormalMap& normal_map,
+                const NamedParameters& np, Core_points<Kernel>& out, Orientation_result& result)
+{
+  typedef typename Kernel::Point_3 Point;
+  typedef typename Kernel::Vector_3 Vector;
+  const std::size_t n = std::size_t(std::distance(points.begin(), points.end()));
+  result.number_of_points = n;
+  out.points.reserve(n);
+  out.normals.reserve(n);
+  std::size_t i = 0;
+  for (auto it = points.begin(); it != points.end(); ++it, ++i) {
+    const Point& p = get(point_map, *it);
+    const Vector v = get(normal_map, *it);
+    const double c[6] = {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z()),
+                         CGAL::to_double(v.x()), CGAL::to_double(v.y()), CGAL::to_double(v.z())};
+    for (int d = 0; d < 6; ++d)
+      if (!std::isfinite(c[d])) {
+        std::ostringstream msg;
+        msg << "orient_normals: point " << i << " has a non-finite " << (d < 3 ? "coordinate" : "normal");
+        throw std::invalid_argument(msg.str());
+      }
+    out.points.push_back(p);
+    const double l2 = c[3] * c[3] + c[4] * c[4] + c[5] * c[5];
+    if (l2 > 0.0) {
+      const double inv = 1.0 / std::sqrt(l2);
+      out.normals.push_back(Vector(c[3] * inv, c[4] * inv, c[5] * inv));
+    } else {
+      out.normals.push_back(Vector(0.0, 0.0, 0.0));
+      ++result.number_of_zero_normals;
+    }
+  }
+  if constexpr (HasConstraints) {
+    const auto cmap = CGAL::parameters::get_parameter(np, CGAL::internal_np::point_is_constrained);
+    out.constrained.reserve(n);
+    for (auto it = points.begin(); it != points.end(); ++it)
+      out.constrained.push_back(get(cmap, *it) ? 1 : 0);
+  }
+  if constexpr (HasPrior) {
+    const auto pmap = CGAL::parameters::get_parameter(np, internal_np::orientation_prior_map);
+    out.prior.reserve(n);
+    std::size_t j = 0;
+    for (auto it = points.begin(); it != points.end(); ++it, ++j) {
+      const double a = double(get(pmap, *it));
+      if (!std::isfinite(a)) {
+        std::ostringstream msg;
+        msg << "orient_normals: point " << j << " has a non-finite orientation prior";
+        throw std::invalid_argument(msg.str());
+      }
+      out.prior.push_back(a);
+    }
+  }
+  (void)np;
+}
+
+/// Renumbers the points along a Morton curve and returns the order (the
+/// input index of each new position): the kNN queries, the graph, the
+/// solver and the sign policy then walk memory in a spatially coherent
+/// order (random input orders cost several times more).  Ties are broken
+/// by input index, so this is deterministic.
+template <typename ConcurrencyTag, typename Kernel>
+std::vector<std::uint32_t> sort_spatially(Core_points<Kernel>& in)
+{
+  const std::size_t n = in.points.size();
+  const std::vector<std::uint32_t> order = morton_order<ConcurrencyTag>(in.points);
+  std::vector<typename Kernel::Point_3> sorted_pts(n);
+  std::vector<typename Kernel::Vector_3> sorted_nrm(n);
+  parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t q = b; q < e; ++q) {
+      sorted_pts[q] = in.points[order[q]];
+      sorted_nrm[q] = in.normals[order[q]];
+    }
+  });
+  in.points.swap(sorted_pts);
+  in.normals.swap(sorted_nrm);
+  if (!in.constrained.empty()) {
+    std::vector<char> sorted_constrained(n);
+    for (std::size_t q = 0; q < n; ++q)
+      sorted_constrained[q] = in.constrained[order[q]];
+    in.constrained.swap(sorted_constrained);
+  }
+  if (!in.prior.empty()) {
+    std::vector<double> sorted_prior(n);
+    for (std::size_t q = 0; q < n; ++q)
+      sorted_prior[q] = in.prior[order[q]];
+    in.prior.swap(sorted_prior);
+  }
+  return order;
+}
+
+/// Runs `solver` on `graph`, with the constraints and priors of `in` as
+/// unary terms when there are any (a constraint outweighs all the edges
+/// together); `has_unary` marks the vertices with a unary term.
+template <bool WithUnary, typename Solver, typename Kernel, typename WeightMap, typename LabelMap>
+Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, WeightMap weight, LabelMap label_map,
+                         const Core_points<Kernel>& in, std::vector<char>& has_unary, Orientation_result& result)
+{
+  if constexpr (WithUnary) {
+    typedef std::pair<double, double> Costs;
+    typedef decltype(boost::make_iterator_property_map(std::declval<std::vector<Costs>&>().begin(),
+                                                       get(boost::vertex_index, graph)))
+      Unary_map;
+    static_assert(Accepts_unary<Solver, Neighbor_graph, WeightMap, Unary_map, LabelMap>::value,
+                  "orient_normals: point_is_constrained_map and orientation_prior_map need a solver with "
+                  "solve(graph, weight, unary, labels)");
+    const std::size_t n = in.points.size();
+    double hard = 1.0;
+    typename boost::graph_traits<Neighbor_graph>::edge_iterator eit, eend;
+    for (boost::tie(eit, eend) = edges(graph); eit != eend; ++eit)
+      hard += std::abs(double(get(weight, *eit)));
+    std::vector<Costs> unary(n, Costs(0.0, 0.0));
+    has_unary.assign(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      double a = in.prior.empty() ? 0.0 : in.prior[i]; // > 0: keep (label +1)
+      if (!in.constrained.empty() && in.constrained[i])
+        a = hard;
+      if (a != 0.0 && in.normals[i] != CGAL::NULL_VECTOR) {
+        unary[i] = a > 0.0 ? Costs(0.0, a) : Costs(-a, 0.0);
+        has_unary[i] = 1;
+        ++result.number_of_unary_terms;
+      }
+    }
+    return solver.solve(graph, weight, boost::make_iterator_property_map(unary.begin(), get(boost::vertex_index, graph)),
+                        label_map);
+  } else {
+    (void)in;
+    (void)has_unary;
+    (void)result;
+    return solver.solve(graph, weight, label_map);
+  }
+}
+
+} // namespace internal
+/// \endcond
+
 /// \ingroup PkgNormalOrientationRef
 /// Orients the normals of `points` consistently and, by default, outward.
 ///
@@ -149,19 +301,13 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
   using CGAL::parameters::choose_parameter;
   using CGAL::parameters::get_parameter;
   typedef CGAL::Point_set_processing_3_np_helper<PointRange, NamedParameters> NP_helper;
-  typedef typename NP_helper::Point_map Point_map;
-  typedef typename NP_helper::Normal_map Normal_map;
   typedef typename NP_helper::Geom_traits Kernel;
-  typedef typename Kernel::Point_3 Point;
-  typedef typename Kernel::Vector_3 Vector;
   static_assert(NP_helper::has_normal_map(), "orient_normals: the normal_map named parameter is required");
 
   const auto t_start = std::chrono::steady_clock::now();
-  const Point_map point_map = NP_helper::get_point_map(points, np);
-  const Normal_map normal_map = NP_helper::get_normal_map(points, np);
+  const auto point_map = NP_helper::get_point_map(points, np);
+  const auto normal_map = NP_helper::get_normal_map(points, np);
   const internal::Settings settings = internal::read_settings(np, "orient_normals");
-  const unsigned int k = settings.number_of_neighbors;
-  const double radius = settings.neighbor_radius;
   const auto criterion = choose_parameter(get_parameter(np, internal_np::flip_criterion), Hoppe_criterion());
   const auto solver = choose_parameter(get_parameter(np, internal_np::solver), Qpbo_i_solver(3, settings.random_seed));
   constexpr bool has_constraints =
@@ -177,58 +323,10 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
   result.component_sign = internal::name_of(sign_policy);
 
   // 1. Copy and check the input; normals are normalised for the criteria.
-  const std::size_t n = std::size_t(std::distance(points.begin(), points.end()));
-  result.number_of_points = n;
-  std::vector<Point> pts;
-  std::vector<Vector> nrm;
-  std::vector<char> constrained;
-  std::vector<double> prior;
-  pts.reserve(n);
-  nrm.reserve(n);
-  {
-    std::size_t i = 0;
-    for (auto it = points.begin(); it != points.end(); ++it, ++i) {
-      const Point& p = get(point_map, *it);
-      const Vector v = get(normal_map, *it);
-      const double c[6] = {CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z()),
-                           CGAL::to_double(v.x()), CGAL::to_double(v.y()), CGAL::to_double(v.z())};
-      for (int d = 0; d < 6; ++d)
-        if (!std::isfinite(c[d])) {
-          std::ostringstream msg;
-          msg << "orient_normals: point " << i << " has a non-finite " << (d < 3 ? "coordinate" : "normal");
-          throw std::invalid_argument(msg.str());
-        }
-      pts.push_back(p);
-      const double l2 = c[3] * c[3] + c[4] * c[4] + c[5] * c[5];
-      if (l2 > 0.0) {
-        const double inv = 1.0 / std::sqrt(l2);
-        nrm.push_back(Vector(c[3] * inv, c[4] * inv, c[5] * inv));
-      } else {
-        nrm.push_back(Vector(0.0, 0.0, 0.0));
-        ++result.number_of_zero_normals;
-      }
-    }
-    if constexpr (has_constraints) {
-      const auto cmap = get_parameter(np, CGAL::internal_np::point_is_constrained);
-      constrained.reserve(n);
-      for (auto it = points.begin(); it != points.end(); ++it)
-        constrained.push_back(get(cmap, *it) ? 1 : 0);
-    }
-    if constexpr (has_prior) {
-      const auto pmap = get_parameter(np, internal_np::orientation_prior_map);
-      prior.reserve(n);
-      std::size_t j = 0;
-      for (auto it = points.begin(); it != points.end(); ++it, ++j) {
-        const double a = double(get(pmap, *it));
-        if (!std::isfinite(a)) {
-          std::ostringstream msg;
-          msg << "orient_normals: point " << j << " has a non-finite orientation prior";
-          throw std::invalid_argument(msg.str());
-        }
-        prior.push_back(a);
-      }
-    }
-  }
+  internal::Core_points<Kernel> in;
+  internal::copy_input<Kernel, PointRange, std::decay_t<decltype(point_map)>, std::decay_t<decltype(normal_map)>,
+                       NamedParameters, has_constraints, has_prior>(points, point_map, normal_map, np, in, result);
+  const std::size_t n = in.points.size();
   if (n == 0) {
     result.seconds.total = result.seconds.input = internal::seconds_since(t_start);
     return result;
@@ -239,43 +337,16 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
     internal::run_with_threads(settings.number_of_threads, [&]() {
       const Progress_reporter& progress = settings.progress;
       progress.part(Stage::INPUT, 0.0, 0.0).report(0.0);
-
-      // Internally, points are numbered along a Morton curve: the kNN
-      // queries, the graph, the solver and the sign policy then walk memory
-      // in a spatially coherent order (random input orders cost several
-      // times more).  Ties are broken by input index, so this is
-      // deterministic; labels are mapped back to the input order at the end.
-      const std::vector<std::uint32_t> order = internal::morton_order<ConcurrencyTag>(pts);
-      {
-        std::vector<Point> sorted_pts(n);
-        std::vector<Vector> sorted_nrm(n);
-        internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
-          for (std::size_t q = b; q < e; ++q) {
-            sorted_pts[q] = pts[order[q]];
-            sorted_nrm[q] = nrm[order[q]];
-          }
-        });
-        pts.swap(sorted_pts);
-        nrm.swap(sorted_nrm);
-        if (has_constraints) {
-          std::vector<char> sorted_constrained(n);
-          for (std::size_t q = 0; q < n; ++q)
-            sorted_constrained[q] = constrained[order[q]];
-          constrained.swap(sorted_constrained);
-        }
-        if (has_prior) {
-          std::vector<double> sorted_prior(n);
-          for (std::size_t q = 0; q < n; ++q)
-            sorted_prior[q] = prior[order[q]];
-          prior.swap(sorted_prior);
-        }
-      }
+      // Labels are mapped back to the input order at the end.
+      const std::vector<std::uint32_t> order = internal::sort_spatially<ConcurrencyTag>(in);
       result.seconds.input = internal::seconds_since(t_start);
 
       // 2. Graph.
       Neighbor_graph graph;
-      const Neighbor_graph_report gr = build_neighbor_graph<ConcurrencyTag, Kernel>(
-        pts, nrm, k, radius, criterion, graph, progress.part(Stage::GRAPH, 0.0, 0.8));
+      const Neighbor_graph_report gr =
+        build_neighbor_graph<ConcurrencyTag, Kernel>(in.points, in.normals, settings.number_of_neighbors,
+                                                     settings.neighbor_radius, criterion, graph,
+                                                     progress.part(Stage::GRAPH, 0.0, 0.8));
       result.number_of_edges = gr.number_of_edges;
       result.number_of_neighbors = gr.number_of_neighbors;
       result.neighbor_radius = gr.radius;
@@ -290,38 +361,8 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       // 3. Solve, with unary terms when there are constraints or priors.
       auto t = std::chrono::steady_clock::now();
       std::vector<char> has_unary; // per vertex, with unary terms only
-      Solver_report sr;
-      if constexpr (has_constraints || has_prior) {
-        typedef std::pair<double, double> Costs;
-        typedef decltype(boost::make_iterator_property_map(std::declval<std::vector<Costs>&>().begin(),
-                                                           get(boost::vertex_index, graph)))
-          Unary_map;
-        static_assert(internal::Accepts_unary<std::decay_t<decltype(solver)>, Neighbor_graph, std::decay_t<decltype(weight)>,
-                                              Unary_map, std::decay_t<decltype(label_map)>>::value,
-                      "orient_normals: point_is_constrained_map and orientation_prior_map need a solver with "
-                      "solve(graph, weight, unary, labels)");
-        // A constraint outweighs all the edges together.
-        double hard = 1.0;
-        typename boost::graph_traits<Neighbor_graph>::edge_iterator eit, eend;
-        for (boost::tie(eit, eend) = edges(graph); eit != eend; ++eit)
-          hard += std::abs(double(get(weight, *eit)));
-        std::vector<Costs> unary(n, Costs(0.0, 0.0));
-        has_unary.assign(n, 0);
-        for (std::size_t i = 0; i < n; ++i) {
-          double a = has_prior ? prior[i] : 0.0; // > 0: keep (label +1)
-          if (has_constraints && constrained[i])
-            a = hard;
-          if (a != 0.0 && nrm[i] != CGAL::NULL_VECTOR) {
-            unary[i] = a > 0.0 ? Costs(0.0, a) : Costs(-a, 0.0);
-            has_unary[i] = 1;
-            ++result.number_of_unary_terms;
-          }
-        }
-        sr = solver.solve(graph, weight, boost::make_iterator_property_map(unary.begin(), get(boost::vertex_index, graph)),
-                          label_map);
-      } else {
-        sr = solver.solve(graph, weight, label_map);
-      }
+      const Solver_report sr =
+        internal::solve_core<has_constraints || has_prior>(solver, graph, weight, label_map, in, has_unary, result);
       result.frustrated_edges = sr.frustrated_edges;
       result.number_of_segments = sr.segments;
       result.seconds.solve = internal::seconds_since(t);
@@ -331,11 +372,10 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       t = std::chrono::steady_clock::now();
       std::vector<std::uint32_t> component;
       result.number_of_components = connected_components(graph, weight, component);
-      const Component_sign_input<Kernel> input{pts, nrm, labels, component, result.number_of_components,
-                                               gr.radius, has_constraints ? &constrained : nullptr};
+      const Component_sign_input<Kernel> input{in.points, in.normals, labels, component, result.number_of_components,
+                                               gr.radius, has_constraints ? &in.constrained : nullptr};
       std::vector<char> flip = component_signs(sign_policy, input);
-      // The solver gave the components with unary terms their sign.
-      for (std::size_t i = 0; i < has_unary.size(); ++i)
+      for (std::size_t i = 0; i < has_unary.size(); ++i) // the solver gave these components their sign
         if (has_unary[i])
           flip[component[i]] = 0;
       for (std::size_t i = 0; i < n; ++i)
@@ -355,14 +395,12 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
 
   // 5. Write back: only the sign changes.
   const auto t_out = std::chrono::steady_clock::now();
-  {
-    std::size_t i = 0;
-    for (auto it = points.begin(); it != points.end(); ++it, ++i)
-      if (input_labels[i] < 0) {
-        put(normal_map, *it, -get(normal_map, *it));
-        ++result.number_of_flipped; // zero normals are never flipped: their edges weigh 0
-      }
-  }
+  std::size_t i = 0;
+  for (auto it = points.begin(); it != points.end(); ++it, ++i)
+    if (input_labels[i] < 0) {
+      put(normal_map, *it, -get(normal_map, *it));
+      ++result.number_of_flipped; // zero normals are never flipped: their edges weigh 0
+    }
   result.seconds.output = internal::seconds_since(t_out);
   result.seconds.total = internal::seconds_since(t_start);
   return result;

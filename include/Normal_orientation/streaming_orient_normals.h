@@ -108,6 +108,36 @@ inline Progress_reporter stage_progress(const Progress_reporter& p, Stage stage)
   return p.part(stage, begin[int(stage)], end[int(stage)]);
 }
 
+/// The first stages: the scan (count, zero normals, frame or order) and,
+/// when r is not given, its estimate; returns the number of points.
+template <typename ConcurrencyTag, typename Kernel, typename Source>
+std::uint64_t scan_and_radius_stages(Source& source, const Streaming_settings& settings, int axis, Sweep_frame& frame,
+                                     Streaming_result& result)
+{
+  using Normal_orientation::internal::seconds_since;
+  auto t = std::chrono::steady_clock::now();
+  const bool estimate_radius = settings.neighbor_radius == 0.0;
+  Scan_result<typename Kernel::Point_3> scanned = scan<typename Kernel::Point_3>(
+    source, axis, estimate_radius, stage_progress(settings.progress, Stage::SCAN));
+  const std::uint64_t n = scanned.number_of_points;
+  frame = scanned.frame;
+  result.number_of_zero_normals = scanned.number_of_zero_normals;
+  result.seconds.frame = seconds_since(t);
+  if (n == 0)
+    return 0;
+  t = std::chrono::steady_clock::now();
+  result.neighbor_radius = settings.neighbor_radius;
+  if (estimate_radius) {
+    const Progress_reporter progress = stage_progress(settings.progress, Stage::RADIUS);
+    progress.report(0, 1);
+    result.neighbor_radius = sample_radius<ConcurrencyTag, Kernel>(scanned.sample, settings.number_of_neighbors, n);
+    result.radius_estimated = true;
+    progress.report(1, 1);
+  }
+  result.seconds.radius = seconds_since(t);
+  return n;
+}
+
 /// The stages, run one after the other (see `streaming_orient_normals()`).
 template <typename ConcurrencyTag, typename Kernel, typename Source, typename Sink, typename FlipCriterion,
           typename Solver, typename SignPolicy, typename Unary>
@@ -128,38 +158,23 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   Component_file_set component_files(settings.component_files); // checks and creates the directory
 
   // 1-2. Scan and radius.
-  auto t = Clock::now();
-  const bool estimate_radius = settings.neighbor_radius == 0.0;
-  Scan_result<typename Kernel::Point_3> scanned =
-    scan<typename Kernel::Point_3>(source, axis, estimate_radius, stage(Stage::SCAN));
-  const std::uint64_t n = scanned.number_of_points;
-  result.number_of_zero_normals = scanned.number_of_zero_normals;
-  result.seconds.frame = seconds_since(t);
+  Sweep_frame frame;
+  const std::uint64_t n = scan_and_radius_stages<ConcurrencyTag, Kernel>(source, settings, axis, frame, result);
   if (n == 0) {
     component_files.keep();
     return;
   }
-  t = Clock::now();
-  double radius = settings.neighbor_radius;
-  if (estimate_radius) {
-    stage(Stage::RADIUS).report(0, 1);
-    radius = sample_radius<ConcurrencyTag, Kernel>(scanned.sample, k, n);
-    std::vector<typename Kernel::Point_3>().swap(scanned.sample);
-    result.radius_estimated = true;
-    stage(Stage::RADIUS).report(1, 1);
-  }
-  result.neighbor_radius = radius;
-  result.seconds.radius = seconds_since(t);
+  const double radius = result.neighbor_radius;
   unary.hard = 1.0 + double(k) * double(n); // outweighs all the edges together
 
   // 3. Sort (unless presorted).
-  t = Clock::now();
+  auto t = Clock::now();
   Sorted_run_reader sorted;
   if (!presorted) {
     const Progress_reporter progress = stage(Stage::SORT);
     progress.report(0, n);
     Reporting_source<Source> counted(source, progress, n);
-    sorted = external_sort(counted, scanned.frame, settings.sort);
+    sorted = external_sort(counted, frame, settings.sort);
     progress.report(n, n);
     result.seconds.sort = seconds_since(t);
   }
@@ -186,7 +201,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     presorted ? sweep<ConcurrencyTag, Kernel>(
                   source, [axis](const Point_record& r) { return r.position[axis]; }, so, visitor, window)
               : sweep<ConcurrencyTag, Kernel>(
-                  sorted, [&scanned](const Point_record& r) { return scanned.frame.key(r); }, so, visitor, window);
+                  sorted, [&frame](const Point_record& r) { return frame.key(r); }, so, visitor, window);
   sorted = Sorted_run_reader(); // removes the sort's files
   if (presorted)
     source.rewind();
