@@ -5,7 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+mkdir -p build
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DNORMAL_ORIENTATION_BUILD_EXAMPLES=ON -DNORMAL_ORIENTATION_BUILD_TESTS=OFF \
-  -DNORMAL_ORIENTATION_BUILD_BENCHMARKS=OFF > build.log 2>&1 || { cat build.log; exit 1; }
-cmake --build build --target orient_normals -j2 >> build.log 2>&1 || { tail -50 build.log; exit 1; }
+  -DNORMAL_ORIENTATION_BUILD_BENCHMARKS=OFF > build/run_sample.log 2>&1 || { cat build/run_sample.log; exit 1; }
+cmake --build build --target orient_normals -j2 >> build/run_sample.log 2>&1 || { tail -50 build/run_sample.log; exit 1; }
 cd build && ./examples/orient_normals "$@"

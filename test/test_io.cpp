@@ -13,7 +13,7 @@ using namespace io_test;
 
 // --------------------------------------------------------------------------- xyz
 
-TEST(Point_cloud_io, xyz_round_trip_with_normals)
+TEST(Point_cloud_io, XyzRoundTripWithNormals)
 {
   Temporary_directory directory;
   const Point_cloud cloud = sample_cloud(true);
@@ -38,7 +38,7 @@ TEST(Point_cloud_io, xyz_round_trip_with_normals)
   EXPECT_FALSE(directory.has_temporary_file());
 }
 
-TEST(Point_cloud_io, xyz_round_trip_without_normals)
+TEST(Point_cloud_io, XyzRoundTripWithoutNormals)
 {
   Temporary_directory directory;
   const Point_cloud cloud = sample_cloud(false);
@@ -54,7 +54,7 @@ TEST(Point_cloud_io, xyz_round_trip_without_normals)
   EXPECT_EQ(std::count(first_line.begin(), first_line.end(), ' '), 2) << first_line;
 }
 
-TEST(Point_cloud_io, xyz_comments_blank_lines_and_line_endings)
+TEST(Point_cloud_io, XyzCommentsBlankLinesAndLineEndings)
 {
   Temporary_directory directory;
   const std::string filename = directory.file("c.xyz");
@@ -72,7 +72,7 @@ TEST(Point_cloud_io, xyz_comments_blank_lines_and_line_endings)
   EXPECT_EQ(cloud.normals[2], (std::array<double, 3>{{0.5, -0.5, 0}}));
 }
 
-TEST(Point_cloud_io, xyz_number_syntax)
+TEST(Point_cloud_io, XyzNumberSyntax)
 {
   Temporary_directory directory;
   write_file(directory.file("n.xyz"), "1. .5 +.25\n1e+05 -0.0e0 7E-3\n0012 1e0 -1.5e-310\n");
@@ -87,7 +87,7 @@ TEST(Point_cloud_io, xyz_number_syntax)
   expect_read_error(directory, "dot.xyz", "1 2 .\n", "non-numeric token '.' at line 1");
 }
 
-TEST(Point_cloud_io, fast_formatting_matches_to_chars)
+TEST(Point_cloud_io, FastFormattingMatchesToChars)
 {
   using Normal_orientation::IO::internal::format_general_fast;
   std::uint64_t state = 12345;
@@ -129,7 +129,7 @@ TEST(Point_cloud_io, fast_formatting_matches_to_chars)
   EXPECT_GT(fast, 300000u); // most values take the fast path
 }
 
-TEST(Point_cloud_io, pwn_and_upper_case_extensions)
+TEST(Point_cloud_io, PwnAndUpperCaseExtensions)
 {
   Temporary_directory directory;
   write_file(directory.file("a.PWN"), "1 2 3 0 1 0\n4 5 6 1 0 0\n");
@@ -144,7 +144,7 @@ TEST(Point_cloud_io, pwn_and_upper_case_extensions)
   expect_same_points(cloud, read_point_cloud(directory.file("d.PLY")));
 }
 
-TEST(Point_cloud_io, empty_files)
+TEST(Point_cloud_io, EmptyFiles)
 {
   Temporary_directory directory;
   write_file(directory.file("e.xyz"), "# nothing\n\n");
@@ -162,7 +162,7 @@ TEST(Point_cloud_io, empty_files)
 
 // --------------------------------------------------------------------------- precision as read
 
-TEST(Point_cloud_io, significant_digits_of_tokens)
+TEST(Point_cloud_io, SignificantDigitsOfTokens)
 {
   using Normal_orientation::IO::internal::significant_digits;
   const std::vector<std::pair<std::string, int>> cases = {
@@ -214,7 +214,7 @@ TEST(Point_cloud_io, significant_digits_of_tokens)
   EXPECT_EQ(Point_cloud().point_digits, 0);
 }
 
-TEST(Point_cloud_io, as_read_reproduces_the_values_bit_for_bit)
+TEST(Point_cloud_io, AsReadReproducesTheValuesBitForBit)
 {
   Temporary_directory directory;
   std::mt19937_64 random(7);
@@ -270,7 +270,7 @@ TEST(Point_cloud_io, as_read_reproduces_the_values_bit_for_bit)
   }
 }
 
-TEST(Point_cloud_io, as_read_writes_like_printf_with_the_digits_read)
+TEST(Point_cloud_io, AsReadWritesLikePrintfWithTheDigitsRead)
 {
   Temporary_directory directory;
   write_file(directory.file("in.xyz"), "0.149716222 -0.487264655 0.213049765 0.00606638857 0.998976844 -0.0448158807\n"
@@ -296,7 +296,7 @@ TEST(Point_cloud_io, as_read_writes_like_printf_with_the_digits_read)
   EXPECT_EQ(file_content(directory.file("out.xyz")).substr(0, 16), "0.15 -0.487 0.21");
 }
 
-TEST(Point_cloud_io, as_read_falls_back_to_shortest_when_digits_are_unknown_or_above_15)
+TEST(Point_cloud_io, AsReadFallsBackToShortestWhenDigitsAreUnknownOrAbove15)
 {
   Temporary_directory directory;
   Write_options as_read;
@@ -337,7 +337,7 @@ TEST(Point_cloud_io, as_read_falls_back_to_shortest_when_digits_are_unknown_or_a
 
 // --------------------------------------------------------------------------- parallel text
 
-TEST(Point_cloud_io, parallel_reading_gives_the_sequential_cloud)
+TEST(Point_cloud_io, ParallelReadingGivesTheSequentialCloud)
 {
   Temporary_directory directory;
   const std::string filename = directory.file("large.xyz");
@@ -376,7 +376,7 @@ TEST(Point_cloud_io, parallel_reading_gives_the_sequential_cloud)
   }
 }
 
-TEST(Point_cloud_io, parallel_writing_gives_the_sequential_file)
+TEST(Point_cloud_io, ParallelWritingGivesTheSequentialFile)
 {
   Temporary_directory directory;
   write_file(directory.file("large.xyz"), large_xyz_text(100000));
@@ -420,7 +420,7 @@ TEST(Point_cloud_io, parallel_writing_gives_the_sequential_file)
   EXPECT_EQ(file_content(directory.file("empty.xyz")), "");
 }
 
-TEST(Point_cloud_io, parallel_reading_reports_the_first_error_with_its_line)
+TEST(Point_cloud_io, ParallelReadingReportsTheFirstErrorWithItsLine)
 {
   Temporary_directory directory;
   const std::size_t lines = 100000;
@@ -492,7 +492,7 @@ TEST(Point_cloud_io, parallel_reading_reports_the_first_error_with_its_line)
     }
 }
 
-TEST(Point_cloud_io, read_and_write_options_keep_their_aggregate_form)
+TEST(Point_cloud_io, ReadAndWriteOptionsKeepTheirAggregateForm)
 {
   const Write_options legacy{false, 12};
   EXPECT_FALSE(legacy.binary);
@@ -507,7 +507,7 @@ TEST(Point_cloud_io, read_and_write_options_keep_their_aggregate_form)
 
 // --------------------------------------------------------------------------- ply reading
 
-TEST(Point_cloud_io, ply_ascii_with_colours_and_faces)
+TEST(Point_cloud_io, PlyAsciiWithColoursAndFaces)
 {
   Temporary_directory directory;
   const std::string filename = directory.file("a.ply");
@@ -551,7 +551,7 @@ TEST(Point_cloud_io, ply_ascii_with_colours_and_faces)
   EXPECT_EQ(cloud.normal_types[2], Ply_scalar_type::FLOAT32);
 }
 
-TEST(Point_cloud_io, ply_binary_little_endian_written_byte_by_byte)
+TEST(Point_cloud_io, PlyBinaryLittleEndianWrittenByteByByte)
 {
   Temporary_directory directory;
   const std::string filename = directory.file("hand.ply");
@@ -591,7 +591,7 @@ TEST(Point_cloud_io, ply_binary_little_endian_written_byte_by_byte)
                   "truncated file: element 'face' declares 1 rows, data end at row 0");
 }
 
-TEST(Point_cloud_io, ply_binary_big_endian_double_with_face_before_vertex)
+TEST(Point_cloud_io, PlyBinaryBigEndianDoubleWithFaceBeforeVertex)
 {
   Temporary_directory directory;
   const std::string filename = directory.file("be.ply");
@@ -631,7 +631,7 @@ TEST(Point_cloud_io, ply_binary_big_endian_double_with_face_before_vertex)
                   "truncated file");
 }
 
-TEST(Point_cloud_io, ply_every_scalar_type_in_both_endiannesses)
+TEST(Point_cloud_io, PlyEveryScalarTypeInBothEndiannesses)
 {
   Temporary_directory directory;
   for(bool big_endian : {false, true}) {
@@ -684,7 +684,7 @@ TEST(Point_cloud_io, ply_every_scalar_type_in_both_endiannesses)
 
 // --------------------------------------------------------------------------- ply writing
 
-TEST(Point_cloud_io, ply_extra_properties_round_trip)
+TEST(Point_cloud_io, PlyExtraPropertiesRoundTrip)
 {
   Temporary_directory directory;
   Point_cloud cloud = sample_cloud(true);
@@ -727,7 +727,7 @@ TEST(Point_cloud_io, ply_extra_properties_round_trip)
   EXPECT_FALSE(directory.has_temporary_file());
 }
 
-TEST(Point_cloud_io, ply_input_types_are_kept_on_output)
+TEST(Point_cloud_io, PlyInputTypesAreKeptOnOutput)
 {
   Temporary_directory directory;
   write_file(directory.file("in.ply"), "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n"
@@ -755,7 +755,7 @@ TEST(Point_cloud_io, ply_input_types_are_kept_on_output)
   EXPECT_EQ(read_point_cloud(directory.file("floats.ply")).normal_types[0], Ply_scalar_type::FLOAT32);
 }
 
-TEST(Point_cloud_io, xyz_to_ply_and_back)
+TEST(Point_cloud_io, XyzToPlyAndBack)
 {
   Temporary_directory directory;
   Write_options exact;
@@ -778,7 +778,7 @@ TEST(Point_cloud_io, xyz_to_ply_and_back)
 
 // --------------------------------------------------------------------------- errors
 
-TEST(Point_cloud_io, missing_file_and_unknown_extension)
+TEST(Point_cloud_io, MissingFileAndUnknownExtension)
 {
   Temporary_directory directory;
   const std::string missing = directory.file("missing.xyz");
@@ -799,7 +799,7 @@ TEST(Point_cloud_io, missing_file_and_unknown_extension)
   EXPECT_EQ(directory.listing(), (std::vector<std::string>{"cloud", "cloud.txt", "dir.xyz"}));
 }
 
-TEST(Point_cloud_io, xyz_errors)
+TEST(Point_cloud_io, XyzErrors)
 {
   Temporary_directory directory;
   expect_read_error(directory, "four.xyz", "1 2 3\n1 2 3 4\n", "wrong column count at line 2: 4 values");
@@ -818,7 +818,7 @@ TEST(Point_cloud_io, xyz_errors)
   expect_read_error(directory, "normal.xyz", "1 2 3 0 0 1\n1 2 3 0 inf 1\n", "non-finite normal at line 2");
 }
 
-TEST(Point_cloud_io, ply_header_errors)
+TEST(Point_cloud_io, PlyHeaderErrors)
 {
   Temporary_directory directory;
   const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
@@ -858,7 +858,7 @@ TEST(Point_cloud_io, ply_header_errors)
                     "count type of a list must be an integer type");
 }
 
-TEST(Point_cloud_io, ply_data_errors)
+TEST(Point_cloud_io, PlyDataErrors)
 {
   Temporary_directory directory;
   const std::string ascii = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
@@ -908,7 +908,7 @@ TEST(Point_cloud_io, ply_data_errors)
 
 // --------------------------------------------------------------------------- atomic writing
 
-TEST(Point_cloud_io, write_to_missing_directory_throws_and_leaves_nothing)
+TEST(Point_cloud_io, WriteToMissingDirectoryThrowsAndLeavesNothing)
 {
   Temporary_directory directory;
   const Point_cloud cloud = sample_cloud(true);
@@ -919,7 +919,7 @@ TEST(Point_cloud_io, write_to_missing_directory_throws_and_leaves_nothing)
   EXPECT_TRUE(directory.listing().empty());
 }
 
-TEST(Point_cloud_io, failed_write_keeps_existing_file)
+TEST(Point_cloud_io, FailedWriteKeepsExistingFile)
 {
   Temporary_directory directory;
   const std::string filename = directory.file("out.ply");
@@ -962,7 +962,7 @@ TEST(Point_cloud_io, failed_write_keeps_existing_file)
   EXPECT_EQ(directory.listing(), (std::vector<std::string>{"dir.ply", "out.ply"}));
 }
 
-TEST(Point_cloud_io, writing_never_leaves_temporary_files)
+TEST(Point_cloud_io, WritingNeverLeavesTemporaryFiles)
 {
   Temporary_directory directory;
   Point_cloud cloud = sample_cloud(true);

@@ -8,7 +8,7 @@
 
 using namespace io_test;
 
-TEST(Point_stream, reads_what_read_point_cloud_reads)
+TEST(Point_stream, ReadsWhatReadPointCloudReads)
 {
   Temporary_directory directory;
   std::vector<std::string> files;
@@ -60,7 +60,7 @@ TEST(Point_stream, reads_what_read_point_cloud_reads)
   }
 }
 
-TEST(Point_stream, reading_errors_name_the_file_and_the_place)
+TEST(Point_stream, ReadingErrorsNameTheFileAndThePlace)
 {
   Temporary_directory directory;
   struct Case
@@ -194,7 +194,7 @@ TEST(Point_stream, reading_errors_name_the_file_and_the_place)
   EXPECT_EQ(chunk[1].position[0], 4.0);
 }
 
-TEST(Point_stream, writer_round_trip)
+TEST(Point_stream, WriterRoundTrip)
 {
   Temporary_directory directory;
   const std::vector<Point_record> records = awkward_records();
@@ -253,7 +253,7 @@ TEST(Point_stream, writer_round_trip)
   EXPECT_EQ(directory.listing(), names);
 }
 
-TEST(Point_stream, uncommitted_or_failed_writer_leaves_no_file)
+TEST(Point_stream, UncommittedOrFailedWriterLeavesNoFile)
 {
   Temporary_directory directory;
   const std::vector<Point_record> records = awkward_records();
@@ -299,7 +299,7 @@ TEST(Point_stream, uncommitted_or_failed_writer_leaves_no_file)
   EXPECT_EQ(directory.listing(), (std::vector<std::string>{"c.ply", "e.ply"}));
 }
 
-TEST(Point_stream, reader_memory_does_not_grow_with_the_file)
+TEST(Point_stream, ReaderMemoryDoesNotGrowWithTheFile)
 {
   Temporary_directory directory;
   const std::size_t n = 200000;

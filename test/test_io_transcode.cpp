@@ -204,7 +204,7 @@ void expect_exception(const std::function<void()>& action, const std::string& ex
 
 } // namespace
 
-TEST(Transcode, bit_set)
+TEST(Transcode, BitSet)
 {
   Bit_set set;
   EXPECT_TRUE(set.empty());
@@ -245,7 +245,7 @@ TEST(Transcode, bit_set)
   EXPECT_EQ(random_bits(1000, 0.5, 1).count(), random_bits(1000, 0.5, 1).count());
 }
 
-TEST(Transcode, the_reader_gives_the_ply_layout)
+TEST(Transcode, TheReaderGivesThePlyLayout)
 {
   Temporary_directory directory;
   write_file(directory.file("cloud.xyz"), "1 2 3\n");
@@ -270,7 +270,7 @@ TEST(Transcode, the_reader_gives_the_ply_layout)
   EXPECT_EQ(layout->vertex_data_offset, layout->header_size + 2 * 5); // two cameras of 5 bytes
 }
 
-TEST(Transcode, binary_ply_round_trips_with_extra_properties)
+TEST(Transcode, BinaryPlyRoundTripsWithExtraProperties)
 {
   Temporary_directory directory;
   std::vector<Transcode_ply> specs;
@@ -321,7 +321,7 @@ TEST(Transcode, binary_ply_round_trips_with_extra_properties)
   EXPECT_FALSE(directory.has_temporary_file());
 }
 
-TEST(Transcode, binary_normals_are_negated_in_their_own_type)
+TEST(Transcode, BinaryNormalsAreNegatedInTheirOwnType)
 {
   Temporary_directory directory;
   // Every value of every normal type, flipped: floats by their sign bit (zeros, the
@@ -355,7 +355,7 @@ TEST(Transcode, binary_normals_are_negated_in_their_own_type)
   }
 }
 
-TEST(Transcode, ascii_ply_keeps_the_text_of_every_other_value)
+TEST(Transcode, AsciiPlyKeepsTheTextOfEveryOtherValue)
 {
   Temporary_directory directory;
   std::vector<Transcode_ply> specs;
@@ -439,7 +439,7 @@ TEST(Transcode, ascii_ply_keeps_the_text_of_every_other_value)
             "1 2 3 5 0 32767\n4 5 6 127 -7 -0\n7 8 9 -5.0 2147483647 +0\n\n");
 }
 
-TEST(Transcode, xyz_keeps_comments_blank_lines_and_digits)
+TEST(Transcode, XyzKeepsCommentsBlankLinesAndDigits)
 {
   Temporary_directory directory;
   // Six columns: comments, blank lines, CRLF line ends, tabs, every number form.
@@ -489,7 +489,7 @@ TEST(Transcode, xyz_keeps_comments_blank_lines_and_digits)
   EXPECT_FALSE(directory.has_temporary_file());
 }
 
-TEST(Transcode, copies_byte_for_byte_when_nothing_changes)
+TEST(Transcode, CopiesByteForByteWhenNothingChanges)
 {
   Temporary_directory directory;
   std::vector<std::pair<std::string, std::string>> files; // name, content
@@ -547,7 +547,7 @@ TEST(Transcode, copies_byte_for_byte_when_nothing_changes)
   }
 }
 
-TEST(Transcode, gives_the_in_core_program_output_byte_for_byte)
+TEST(Transcode, GivesTheInCoreProgramOutputByteForByte)
 {
   // The in-core program reads the file, negates normals and writes it with
   // PRECISION_AS_READ (binary PLY unless --ascii). On files that this writer wrote (PLY:
@@ -587,7 +587,7 @@ TEST(Transcode, gives_the_in_core_program_output_byte_for_byte)
   }
 }
 
-TEST(Transcode, reading_errors_are_those_of_the_reader)
+TEST(Transcode, ReadingErrorsAreThoseOfTheReader)
 {
   // Every bad input of the command-line tests: the reader's error, word for word, and
   // no output. The files without any point are copied as they are.
@@ -639,7 +639,7 @@ TEST(Transcode, reading_errors_are_those_of_the_reader)
   }
 }
 
-TEST(Transcode, refuses_what_it_cannot_do_before_writing)
+TEST(Transcode, RefusesWhatItCannotDoBeforeWriting)
 {
   Temporary_directory directory;
   Transcode_ply spec;
@@ -678,7 +678,7 @@ TEST(Transcode, refuses_what_it_cannot_do_before_writing)
   EXPECT_EQ(directory.listing(), std::vector<std::string>({"cloud.xyz", "unsigned.ply"}));
 }
 
-TEST(Transcode, unwritable_output_leaves_nothing)
+TEST(Transcode, UnwritableOutputLeavesNothing)
 {
   Temporary_directory directory;
   const std::string input = directory.file("cloud.ply");
@@ -698,7 +698,7 @@ TEST(Transcode, unwritable_output_leaves_nothing)
   EXPECT_EQ(directory.listing(), std::vector<std::string>({"cloud.ply", "file", "out.ply"}));
 }
 
-TEST(Transcode, output_is_a_registered_temporary_file_until_complete)
+TEST(Transcode, OutputIsARegisteredTemporaryFileUntilComplete)
 {
   Temporary_directory directory;
   const std::string input = directory.file("cloud.ply");
@@ -736,7 +736,7 @@ TEST(Transcode, output_is_a_registered_temporary_file_until_complete)
   EXPECT_EQ(last_bytes, fs::file_size(input));
 }
 
-TEST(Transcode, input_changing_under_it_is_an_error)
+TEST(Transcode, InputChangingUnderItIsAnError)
 {
   Temporary_directory directory;
   Transcode_ply spec;
@@ -775,7 +775,7 @@ TEST(Transcode, input_changing_under_it_is_an_error)
   }
 }
 
-TEST(Transcode, in_place)
+TEST(Transcode, InPlace)
 {
   Temporary_directory directory;
   const std::string input = directory.file("cloud.ply");

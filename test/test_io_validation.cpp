@@ -40,7 +40,7 @@ std::string binary_xyz_header(const std::string& n, const std::string& more = st
 
 } // namespace
 
-TEST(Input_validation, empty_files)
+TEST(Input_validation, EmptyFiles)
 {
   Temporary_directory directory;
   // An empty text file is a valid cloud of no point (the program refuses it later).
@@ -56,7 +56,7 @@ TEST(Input_validation, empty_files)
   expect_same_error_everywhere(directory.file("magic_only.ply"), "bad PLY header: no 'end_header' line");
 }
 
-TEST(Input_validation, vertex_count_larger_than_the_file)
+TEST(Input_validation, VertexCountLargerThanTheFile)
 {
   Temporary_directory directory;
   // Counts far beyond the size of the file fail without allocating for them.
@@ -97,7 +97,7 @@ TEST(Input_validation, vertex_count_larger_than_the_file)
   EXPECT_EQ(stream_error(directory.file("faces.ply")), error_message([&] { read_point_cloud(directory.file("faces.ply")); }));
 }
 
-TEST(Input_validation, binary_errors_name_the_byte_offset)
+TEST(Input_validation, BinaryErrorsNameTheByteOffset)
 {
   Temporary_directory directory;
   const std::string header = binary_xyz_header("3", "property float nx\nproperty float ny\nproperty float nz\n");
@@ -146,7 +146,7 @@ TEST(Input_validation, binary_errors_name_the_byte_offset)
                                                                "(byte offset " + std::to_string(lists.size() + 5) + ")");
 }
 
-TEST(Input_validation, garbage_after_the_header)
+TEST(Input_validation, GarbageAfterTheHeader)
 {
   Temporary_directory directory;
   const std::string ascii = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
@@ -174,7 +174,7 @@ TEST(Input_validation, garbage_after_the_header)
   // streamed (Point_stream, reading_errors_name_the_file_and_the_place).
 }
 
-TEST(Input_validation, control_characters_in_messages_are_escaped)
+TEST(Input_validation, ControlCharactersInMessagesAreEscaped)
 {
   Temporary_directory directory;
   write_file(directory.file("token.xyz"), "1 2 3\n1 2 \x01\x1b[2J\n");
@@ -199,7 +199,7 @@ TEST(Input_validation, control_characters_in_messages_are_escaped)
                                "non-numeric token '" + std::string(40, 'x') + "...' at line 1");
 }
 
-TEST(Input_validation, ascii_ply_float_values_are_the_nearest_floats)
+TEST(Input_validation, AsciiPlyFloatValuesAreTheNearestFloats)
 {
   Temporary_directory directory;
   const float largest = std::numeric_limits<float>::max();
@@ -237,7 +237,7 @@ TEST(Input_validation, ascii_ply_float_values_are_the_nearest_floats)
   expect_records_of_cloud(read_stream(reader, 4), back, "extreme.ply");
 }
 
-TEST(Input_validation, ascii_ply_integer_minus_zero_is_zero)
+TEST(Input_validation, AsciiPlyIntegerMinusZeroIsZero)
 {
   Temporary_directory directory;
   // `-0.0` for an integer property was kept as -0.0, which no binary integer holds: the
@@ -258,7 +258,7 @@ TEST(Input_validation, ascii_ply_integer_minus_zero_is_zero)
   }
 }
 
-TEST(Input_validation, integer_normals_are_written_exactly)
+TEST(Input_validation, IntegerNormalsAreWrittenExactly)
 {
   Temporary_directory directory;
   // 32-bit integer normals were written as float, which rounded large values.
@@ -282,7 +282,7 @@ TEST(Input_validation, integer_normals_are_written_exactly)
   }
 }
 
-TEST(Input_validation, unreadable_input_and_unwritable_output)
+TEST(Input_validation, UnreadableInputAndUnwritableOutput)
 {
   Temporary_directory directory;
   // A path through a regular file can be neither read nor written, even by root.
@@ -319,7 +319,7 @@ TEST(Input_validation, unreadable_input_and_unwritable_output)
 // (see the README there) and read here, in core and streamed: a clean error (one
 // printable line naming the file), or a cloud that satisfies the reader's contract and
 // comes back unchanged from the files the writers write.
-TEST(Input_validation, fuzzer_regressions)
+TEST(Input_validation, FuzzerRegressions)
 {
   struct Case
   {

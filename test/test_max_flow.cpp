@@ -233,7 +233,7 @@ void check_fresh(const Problem& p)
   EXPECT_TRUE(source_side_is_residual_reachable(mf));
 }
 
-TEST(Max_flow, random_graphs_against_boost)
+TEST(Max_flow, RandomGraphsAgainstBoost)
 {
   std::mt19937 rng(12345);
   for (int k = 0; k < 400; ++k) {
@@ -247,7 +247,7 @@ TEST(Max_flow, random_graphs_against_boost)
   }
 }
 
-TEST(Max_flow, integer_graphs_against_boost)
+TEST(Max_flow, IntegerGraphsAgainstBoost)
 {
   std::mt19937 rng(777);
   for (int k = 0; k < 200; ++k) {
@@ -267,13 +267,13 @@ TEST(Max_flow, integer_graphs_against_boost)
   }
 }
 
-TEST(Max_flow, grid_100x100)
+TEST(Max_flow, Grid100x100)
 {
   std::mt19937 rng(4);
   check_fresh(grid_problem(rng, 100, 100));
 }
 
-TEST(Max_flow, repeated_max_flow_without_change)
+TEST(Max_flow, RepeatedMaxFlowWithoutChange)
 {
   std::mt19937 rng(5);
   Problem p = random_problem(rng, 200, 4, 0.3);
@@ -325,7 +325,7 @@ void change_terminals(std::mt19937& rng, Problem& p, Max_flow& mf, std::size_t c
   }
 }
 
-TEST(Max_flow, incremental_terminal_changes)
+TEST(Max_flow, IncrementalTerminalChanges)
 {
   std::mt19937 rng(2024);
   for (int k = 0; k < 150; ++k) {
@@ -352,7 +352,7 @@ TEST(Max_flow, incremental_terminal_changes)
   }
 }
 
-TEST(Max_flow, incremental_fixing_nodes_like_qpbo)
+TEST(Max_flow, IncrementalFixingNodesLikeQpbo)
 {
   // a large unary fixes a node at a time, then the graph is re-solved
   std::mt19937 rng(99);
@@ -374,7 +374,7 @@ TEST(Max_flow, incremental_fixing_nodes_like_qpbo)
   }
 }
 
-TEST(Max_flow, incremental_added_edges)
+TEST(Max_flow, IncrementalAddedEdges)
 {
   std::mt19937 rng(31);
   for (int k = 0; k < 50; ++k) {
@@ -403,7 +403,7 @@ TEST(Max_flow, incremental_added_edges)
   }
 }
 
-TEST(Max_flow, incremental_grid)
+TEST(Max_flow, IncrementalGrid)
 {
   std::mt19937 rng(8);
   Problem p = grid_problem(rng, 100, 100);
@@ -419,7 +419,7 @@ TEST(Max_flow, incremental_grid)
   }
 }
 
-TEST(Max_flow, degenerate_graphs)
+TEST(Max_flow, DegenerateGraphs)
 {
   { // no node
     Max_flow mf;

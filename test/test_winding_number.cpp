@@ -87,7 +87,7 @@ bool same_bits(const std::vector<double>& a, const std::vector<double>& b)
 
 } // namespace
 
-TEST(WindingNumberAreas, SumToTheAreaOfASphere)
+TEST(Winding_number_areas, SumToTheAreaOfASphere)
 {
   const Cloud c = sphere_cloud(20000, 1);
   double sum = 0.0;
@@ -99,7 +99,7 @@ TEST(WindingNumberAreas, SumToTheAreaOfASphere)
   EXPECT_NEAR(sum / (4.0 * M_PI), 1.0, 0.03);
 }
 
-TEST(WindingNumberAreas, RegularGridDuplicatesAndSmallClouds)
+TEST(Winding_number_areas, RegularGridDuplicatesAndSmallClouds)
 {
   // a 20 x 20 grid of spacing h in the plane z = 1: interior cells are h x h squares
   const double h = 0.1;
@@ -141,7 +141,7 @@ TEST(WindingNumberAreas, RegularGridDuplicatesAndSmallClouds)
   EXPECT_THROW(NO::estimate_point_areas(points, normals), std::invalid_argument);
 }
 
-TEST(WindingNumberField, TreecodeMatchesTheDirectSum)
+TEST(Winding_number_field, TreecodeMatchesTheDirectSum)
 {
   for (int shape = 0; shape < 2; ++shape) {
     std::mt19937_64 rng(7);
@@ -179,7 +179,7 @@ TEST(WindingNumberField, TreecodeMatchesTheDirectSum)
   }
 }
 
-TEST(WindingNumberField, SampledSphereIsOneInsideZeroOutsideHalfOnTheSurface)
+TEST(Winding_number_field, SampledSphereIsOneInsideZeroOutsideHalfOnTheSurface)
 {
   const Cloud c = sphere_cloud(20000, 3);
   Field field;
@@ -215,7 +215,7 @@ TEST(WindingNumberField, SampledSphereIsOneInsideZeroOutsideHalfOnTheSurface)
   EXPECT_NEAR(sharp.value(Point(0.1, 0.2, 0.3)), field.value(Point(0.1, 0.2, 0.3)), 5e-3);
 }
 
-TEST(WindingNumberField, FlippingAPatchSubtractsTwiceItsField)
+TEST(Winding_number_field, FlippingAPatchSubtractsTwiceItsField)
 {
   const Cloud c = sphere_cloud(30000, 9);
   std::vector<std::size_t> patch;
@@ -269,7 +269,7 @@ TEST(WindingNumberField, FlippingAPatchSubtractsTwiceItsField)
   EXPECT_THROW(whole.negate(std::vector<std::size_t>(1, c.points.size())), std::out_of_range);
 }
 
-TEST(WindingNumberField, SameOutputForOneAndTwoThreads)
+TEST(Winding_number_field, SameOutputForOneAndTwoThreads)
 {
   const Cloud c = sphere_cloud(100000, 17);
   const std::vector<Point> q = make_queries(c, 20000, 19);
@@ -306,7 +306,7 @@ TEST(WindingNumberField, SameOutputForOneAndTwoThreads)
   }
 }
 
-TEST(WindingNumberField, GradientMatchesFiniteDifferences)
+TEST(Winding_number_field, GradientMatchesFiniteDifferences)
 {
   std::mt19937_64 rng(23);
   const Cloud c = make_cloud(NO::test::torus(20000, rng));
@@ -324,7 +324,7 @@ TEST(WindingNumberField, GradientMatchesFiniteDifferences)
   }
 }
 
-TEST(WindingNumberField, SmallAndBadInputs)
+TEST(Winding_number_field, SmallAndBadInputs)
 {
   Field empty;
   EXPECT_EQ(empty.size(), 0u);
