@@ -7,6 +7,7 @@
 #ifndef NORMAL_ORIENTATION_EXAMPLES_CLI_CLI_OPTIONS_H
 #define NORMAL_ORIENTATION_EXAMPLES_CLI_CLI_OPTIONS_H
 
+#include <Normal_orientation/IO/File_format.h>
 #include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/streaming/Streaming_settings.h>
 
@@ -141,15 +142,6 @@ T parse_number(const std::string& option, const std::string& text)
   if (!(in >> value) || !in.eof())
     throw Usage_error("invalid value '" + text + "' for " + option);
   return value;
-}
-
-/// the extension of `filename`, dot included, in lower case ("" if none)
-inline std::string lower_case_extension(const std::string& filename)
-{
-  std::string extension = std::filesystem::path(filename).extension().string();
-  for (char& c : extension)
-    c = char(std::tolower(static_cast<unsigned char>(c)));
-  return extension;
 }
 
 /// reads option `a` (at argv[i]) into `o`, with `value()` its value;
@@ -331,7 +323,7 @@ inline Options parse_options(int argc, char** argv, const std::string& sample_cl
     throw Usage_error("too many arguments");
   internal::check_combinations(o);
   internal::choose_files(o, positional, sample_cloud);
-  using internal::lower_case_extension;
+  using Normal_orientation::IO::lower_case_extension;
   if (o.write_segments && lower_case_extension(o.output) != ".ply")
     throw Usage_error("--write-segments needs a .ply OUT");
   if (o.keep_order && (lower_case_extension(o.input) == ".ply") != (lower_case_extension(o.output) == ".ply"))
