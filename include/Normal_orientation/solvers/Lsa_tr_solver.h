@@ -11,6 +11,7 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/internal/Max_flow.h>
 #include <Normal_orientation/solvers/Mst_solver.h>
+#include <Normal_orientation/solvers/Orientation_solver_base.h>
 #include <Normal_orientation/solvers/Solver_report.h>
 
 #include <boost/graph/graph_traits.hpp>
@@ -99,13 +100,21 @@ namespace Normal_orientation {
 /// labelling is the best one seen and its energy is never above the
 /// starting MST labelling's.  The solver is deterministic.
 ///
+/// <b>Contract of `solve()`</b> (both calls, see `Orientation_solver_base`).
+/// The minimum is local.  Unary costs may be negative; with them the start
+/// is `initial.solve(g, weight, unary, ...)`, the unary terms are kept
+/// exactly in every sub-problem, only the components of the non-zero edges
+/// without unary terms (c+ = c- at all their vertices) get an anchor, and
+/// `Solver_report::energy` includes the unary costs.  Throws
+/// `std::invalid_argument` if a unary cost is not finite.
+///
 /// `Solver_report::iterations` counts the max-flows solved.
 ///
 /// Cost: O(V + E) to build each max-flow plus the flow computation, at most
 /// `maximum_iterations` times; memory about 16 bytes per edge for the
 /// terms plus the max-flow graph of the submodular edges.
 /// \cgalModels `OrientationSolver`
-class Lsa_tr_solver
+class Lsa_tr_solver : public Orientation_solver_base<Lsa_tr_solver>
 {
 public:
   /// the name used on the command line and in reports
@@ -140,51 +149,11 @@ public:
     : initial(start), maximum_iterations(iterations)
   {}
 
-  /// Solves the orientation problem on `g` with the signed edge weights
-  /// `weight` and writes +1/-1 to `labels` for every vertex.
-  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
-  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
-  /// \tparam WeightMap a readable edge property map with a floating value
-  /// \tparam LabelMap a writable vertex property map accepting `Label`
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve
-  template <typename Graph, typename WeightMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
-  {
-    return solve_impl(g, weight, internal::No_unary(), labels);
-  }
-
-  /// Solves the orientation problem with unary terms: minimises (locally)
-  /// E(L) = sum over the edges of `edge_energy(w_e, L_i, L_j)` + sum over the
-  /// vertices of the unary cost of L_i (see the `energy()` overload with a
-  /// `unary` map), and writes +1/-1 to `labels` for every vertex.  Unary
-  /// costs may be negative.  The start is `initial.solve(g, weight, unary,
-  /// ...)`, the unary terms are kept exactly in every sub-problem, and only
-  /// the components of the non-zero edges without unary terms (c+ = c- at
-  /// all their vertices) get an anchor (see the class description).
-  /// `Solver_report::energy` includes the unary costs.
-  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
-  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
-  /// \tparam WeightMap a readable edge property map with a floating value
-  /// \tparam UnaryMap a readable vertex property map whose value has members
-  ///         `first` (the cost of label +1) and `second` (the cost of label
-  ///         -1) convertible to `double`, such as `std::pair<double, double>`
-  /// \tparam LabelMap a writable vertex property map accepting `Label`
-  /// \throw std::invalid_argument if a unary cost is not finite
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param unary the costs of the labels +1 (`first`) and -1 (`second`) of every vertex
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve (its energy includes the unary costs)
-  template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
-  {
-    return solve_impl(g, weight, unary, labels);
-  }
-
 private:
+  /// \cond SKIP_IN_MANUAL
+  friend class Orientation_solver_base<Lsa_tr_solver>; // calls solve_impl()
+  /// \endcond
+
   /// The solve, without unary terms when `UnaryMap` is `internal::No_unary`.
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Solver_report solve_impl(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
