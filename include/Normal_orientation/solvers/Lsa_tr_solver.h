@@ -267,6 +267,18 @@ private:
     return anchor;
   }
 
+  /// `e` plus, with unary terms, the modular terms of the z_i = 1, added
+  /// one by one in vertex order
+  template <bool with_unary>
+  static double with_modular(const Permuted_problem& p, const std::vector<unsigned char>& z, double e)
+  {
+    if constexpr (with_unary)
+      for (std::size_t i = 0; i < z.size(); ++i)
+        if (z[i])
+          e += p.modular[i];
+    return e;
+  }
+
   /// E(z) up to the constant of the loops and of the unary terms at y
   template <bool with_unary>
   static double z_energy(const Permuted_problem& p, const std::vector<unsigned char>& z)
@@ -275,11 +287,7 @@ private:
     for (const Term& t : p.terms)
       if ((t.c > 0.0) == (z[t.u] != z[t.v]))
         e += std::abs(t.c);
-    if constexpr (with_unary)
-      for (std::size_t i = 0; i < z.size(); ++i)
-        if (z[i])
-          e += p.modular[i];
-    return e;
+    return with_modular<with_unary>(p, z, e);
   }
 
   /// the approximation of E(z) around `zt`, up to the same constant
@@ -297,11 +305,7 @@ private:
         e += -t.c * (1.0 - z[t.u] - z[t.v] + 2.0 * (z[t.u] * b + a * z[t.v] - a * b));
       }
     }
-    if constexpr (with_unary)
-      for (std::size_t i = 0; i < z.size(); ++i)
-        if (z[i])
-          e += p.modular[i];
-    return e;
+    return with_modular<with_unary>(p, z, e);
   }
 
   /// The trust-region iterations from z = 0 (see the class description);
