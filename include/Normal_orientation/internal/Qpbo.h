@@ -363,6 +363,18 @@ private:
     m_penalty = p;
   }
 
+  // the residual graph after the maximum flow, symmetrised (see the class
+  // description): terminal residuals tau (> 0: reachable from s), then the
+  // arcs of positive residual capacity, out of node p at head[start[p] ...
+  // start[p + 1] - 1]
+  struct Residual_graph
+  {
+    std::vector<double> tau;
+    std::vector<Index> start, head;
+  };
+
+  // labels from the persistencies: the strong ones, then if `weak` the weak
+  // ones (see the class description)
   void compute_labels(bool weak)
   {
     const std::size_t n = m_unary.size();
@@ -371,57 +383,8 @@ private:
     if (n == 0)
       return;
 
-    // symmetrised residual graph: terminal links, then arcs (CSR)
-    std::vector<double> tau(nn);
-    for (std::size_t i = 0; i < n; ++i) {
-      const Index p = node_of(i);
-      const double t = (m_graph.terminal_residual(p) - m_graph.terminal_residual(mirror(p))) / 2;
-      tau[p] = t;
-      tau[mirror(p)] = -t;
-    }
-    const std::size_t ne = m_graph.number_of_edges();
-    std::vector<double> fwd(ne), rev(ne);
-    std::vector<Index> start(nn + 1, 0);
-    for (std::size_t e = 0; e < ne; e += 2) {
-      const Index a = Index(e), b = Index(e + 1);
-      fwd[e] = fwd[e + 1] = (m_graph.edge_residual(a, false) + m_graph.edge_residual(b, false)) / 2;
-      rev[e] = rev[e + 1] = (m_graph.edge_residual(a, true) + m_graph.edge_residual(b, true)) / 2;
-    }
-    for (std::size_t e = 0; e < ne; ++e) {
-      if (fwd[e] > 0)
-        ++start[m_graph.edge_source(Index(e)) + 1];
-      if (rev[e] > 0)
-        ++start[m_graph.edge_target(Index(e)) + 1];
-    }
-    for (std::size_t p = 0; p < nn; ++p)
-      start[p + 1] += start[p];
-    std::vector<Index> head(start[nn]);
-    {
-      std::vector<Index> pos(start.begin(), start.end() - 1);
-      for (std::size_t e = 0; e < ne; ++e) {
-        const Index u = m_graph.edge_source(Index(e)), v = m_graph.edge_target(Index(e));
-        if (fwd[e] > 0)
-          head[pos[u]++] = v;
-        if (rev[e] > 0)
-          head[pos[v]++] = u;
-      }
-    }
-
-    // nodes reachable from s
-    std::vector<char> from_s(nn, 0);
-    std::vector<Index> queue;
-    queue.reserve(nn);
-    for (std::size_t p = 0; p < nn; ++p)
-      if (tau[p] > 0) {
-        from_s[p] = 1;
-        queue.push_back(Index(p));
-      }
-    for (std::size_t k = 0; k < queue.size(); ++k)
-      for (Index a = start[queue[k]]; a < start[queue[k] + 1]; ++a)
-        if (!from_s[head[a]]) {
-          from_s[head[a]] = 1;
-          queue.push_back(head[a]);
-        }
+    const Residual_graph r = residual_graph();
+    const std::vector<char> from_s = reachable_from_source(r);
     for (std::size_t i = 0; i < n; ++i) {
       const Index p = node_of(i);
       if (from_s[p] && !from_s[mirror(p)])
@@ -438,30 +401,114 @@ private:
     for (std::size_t p = 0; p < nn; ++p)
       middle[p] = !from_s[p] && !from_s[mirror(Index(p))];
 
-    // strongly connected components of the middle part (Tarjan, iterative)
+    std::vector<Index> comp;
+    const Index components = strongly_connected_components(r, middle, comp);
+    if (components == 0)
+      return;
+    const std::vector<Index> rank = topological_ranks(r, middle, comp, components);
+
+    // node i on the source side iff its component comes after that of ī
+    for (std::size_t i = 0; i < n; ++i) {
+      const Index p = node_of(i);
+      if (!middle[p] || comp[p] == comp[mirror(p)])
+        continue;
+      m_label[i] = rank[comp[p]] > rank[comp[mirror(p)]] ? 0 : 1;
+    }
+  }
+
+  // the symmetrised residual graph: terminal links, then arcs (CSR)
+  Residual_graph residual_graph() const
+  {
+    const std::size_t n = m_unary.size();
+    const std::size_t nn = 2 * n;
+    Residual_graph r;
+    r.tau.resize(nn);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Index p = node_of(i);
+      const double t = (m_graph.terminal_residual(p) - m_graph.terminal_residual(mirror(p))) / 2;
+      r.tau[p] = t;
+      r.tau[mirror(p)] = -t;
+    }
+    const std::size_t ne = m_graph.number_of_edges();
+    std::vector<double> fwd(ne), rev(ne);
+    r.start.assign(nn + 1, 0);
+    for (std::size_t e = 0; e < ne; e += 2) {
+      const Index a = Index(e), b = Index(e + 1);
+      fwd[e] = fwd[e + 1] = (m_graph.edge_residual(a, false) + m_graph.edge_residual(b, false)) / 2;
+      rev[e] = rev[e + 1] = (m_graph.edge_residual(a, true) + m_graph.edge_residual(b, true)) / 2;
+    }
+    for (std::size_t e = 0; e < ne; ++e) {
+      if (fwd[e] > 0)
+        ++r.start[m_graph.edge_source(Index(e)) + 1];
+      if (rev[e] > 0)
+        ++r.start[m_graph.edge_target(Index(e)) + 1];
+    }
+    for (std::size_t p = 0; p < nn; ++p)
+      r.start[p + 1] += r.start[p];
+    r.head.resize(r.start[nn]);
+    std::vector<Index> pos(r.start.begin(), r.start.end() - 1);
+    for (std::size_t e = 0; e < ne; ++e) {
+      const Index u = m_graph.edge_source(Index(e)), v = m_graph.edge_target(Index(e));
+      if (fwd[e] > 0)
+        r.head[pos[u]++] = v;
+      if (rev[e] > 0)
+        r.head[pos[v]++] = u;
+    }
+    return r;
+  }
+
+  // 1 for the nodes reachable from s in `r`, 0 for the others
+  static std::vector<char> reachable_from_source(const Residual_graph& r)
+  {
+    const std::size_t nn = r.tau.size();
+    std::vector<char> from_s(nn, 0);
+    std::vector<Index> queue;
+    queue.reserve(nn);
+    for (std::size_t p = 0; p < nn; ++p)
+      if (r.tau[p] > 0) {
+        from_s[p] = 1;
+        queue.push_back(Index(p));
+      }
+    for (std::size_t k = 0; k < queue.size(); ++k)
+      for (Index a = r.start[queue[k]]; a < r.start[queue[k] + 1]; ++a)
+        if (!from_s[r.head[a]]) {
+          from_s[r.head[a]] = 1;
+          queue.push_back(r.head[a]);
+        }
+    return from_s;
+  }
+
+  // the strongly connected components of the `middle` part of `r` (Tarjan,
+  // iterative): comp[p] is the component of a middle node p; returns their
+  // number
+  static Index strongly_connected_components(const Residual_graph& r, const std::vector<char>& middle,
+                                             std::vector<Index>& comp)
+  {
+    const std::size_t nn = r.tau.size();
     const Index none = std::numeric_limits<Index>::max();
-    std::vector<Index> order(nn, none), low(nn, 0), comp(nn, none);
+    std::vector<Index> order(nn, none), low(nn, 0);
+    comp.assign(nn, none);
     std::vector<Index> stack;
     std::vector<std::pair<Index, Index>> calls; // node, next arc
     Index counter = 0, components = 0;
-    for (std::size_t r = 0; r < nn; ++r) {
-      if (!middle[r] || order[r] != none)
+    for (std::size_t root = 0; root < nn; ++root) {
+      if (!middle[root] || order[root] != none)
         continue;
-      order[r] = low[r] = counter++;
-      stack.push_back(Index(r));
-      calls.emplace_back(Index(r), start[r]);
+      order[root] = low[root] = counter++;
+      stack.push_back(Index(root));
+      calls.emplace_back(Index(root), r.start[root]);
       while (!calls.empty()) {
         const Index v = calls.back().first;
         const Index a = calls.back().second;
-        if (a < start[v + 1]) {
+        if (a < r.start[v + 1]) {
           ++calls.back().second;
-          const Index w = head[a];
+          const Index w = r.head[a];
           if (!middle[w])
             continue;
           if (order[w] == none) {
             order[w] = low[w] = counter++;
             stack.push_back(w);
-            calls.emplace_back(w, start[w]);
+            calls.emplace_back(w, r.start[w]);
           } else if (comp[w] == none) { // on the stack
             low[v] = std::min(low[v], order[w]);
           }
@@ -481,20 +528,26 @@ private:
         }
       }
     }
-    if (components == 0)
-      return;
+    return components;
+  }
 
-    // canonical topological order of the components (Kahn, smallest key
-    // first, the key of a component being its smallest node)
+  // the rank of each of the `components` components in their canonical
+  // topological order (Kahn, smallest key first, the key of a component
+  // being its smallest node)
+  static std::vector<Index> topological_ranks(const Residual_graph& r, const std::vector<char>& middle,
+                                              const std::vector<Index>& comp, Index components)
+  {
+    const std::size_t nn = r.tau.size();
+    const Index none = std::numeric_limits<Index>::max();
     std::vector<Index> key(components, none), in_degree(components, 0);
     std::vector<Index> comp_start(components + 1, 0);
     for (std::size_t p = 0; p < nn; ++p)
       if (middle[p]) {
         key[comp[p]] = std::min(key[comp[p]], Index(p));
         ++comp_start[comp[p] + 1];
-        for (Index a = start[p]; a < start[p + 1]; ++a)
-          if (middle[head[a]] && comp[head[a]] != comp[p])
-            ++in_degree[comp[head[a]]];
+        for (Index a = r.start[p]; a < r.start[p + 1]; ++a)
+          if (middle[r.head[a]] && comp[r.head[a]] != comp[p])
+            ++in_degree[comp[r.head[a]]];
       }
     for (Index c = 0; c < components; ++c)
       comp_start[c + 1] += comp_start[c];
@@ -518,21 +571,14 @@ private:
       rank[c] = next++;
       for (Index m = comp_start[c]; m < comp_start[c + 1]; ++m) {
         const Index p = members[m];
-        for (Index a = start[p]; a < start[p + 1]; ++a) {
-          const Index q = head[a];
+        for (Index a = r.start[p]; a < r.start[p + 1]; ++a) {
+          const Index q = r.head[a];
           if (middle[q] && comp[q] != c && --in_degree[comp[q]] == 0)
             ready.push(Entry(key[comp[q]], comp[q]));
         }
       }
     }
-
-    // node i on the source side iff its component comes after that of ī
-    for (std::size_t i = 0; i < n; ++i) {
-      const Index p = node_of(i);
-      if (!middle[p] || comp[p] == comp[mirror(p)])
-        continue;
-      m_label[i] = rank[comp[p]] > rank[comp[mirror(p)]] ? 0 : 1;
-    }
+    return rank;
   }
 
   Max_flow m_graph;

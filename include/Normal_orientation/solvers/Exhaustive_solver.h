@@ -8,6 +8,7 @@
 /// other solvers are tested against.
 
 #include <Normal_orientation/Orientation_problem.h>
+#include <Normal_orientation/solvers/Orientation_solver_base.h>
 #include <Normal_orientation/solvers/Solver_report.h>
 
 #include <boost/graph/graph_traits.hpp>
@@ -63,10 +64,19 @@ namespace Normal_orientation {
 /// `energy()`.  Edges of weight zero and self-loops (whose term does not
 /// depend on the labels) are ignored by the enumeration, not by the report.
 ///
+/// <b>Contract of `solve()`</b> (both calls, see `Orientation_solver_base`).
+/// The minimum is exact.  `Solver_report::iterations` is the number of
+/// states visited, summed over the components: 2^(k-1) for a component of k
+/// vertices (1 for a vertex without informative edges), 2^k with unary
+/// terms.  Unary costs may be negative.  Throws `std::length_error` if a
+/// connected component of the edges of non-zero weight has more than
+/// `maximum_vertices` vertices, `std::invalid_argument` if a weight or a
+/// unary cost is not finite.
+///
 /// Cost: O(sum over the components of 2^(k-1) * average degree), plus
 /// O(V + E).  Components larger than `maximum_vertices` are refused.
 /// \cgalModels `OrientationSolver`
-class Exhaustive_solver
+class Exhaustive_solver : public Orientation_solver_base<Exhaustive_solver>
 {
 public:
   /// the name used on the command line and in reports
@@ -81,55 +91,11 @@ public:
   /// the solver accepting components of at most `maximum` vertices
   explicit Exhaustive_solver(unsigned int maximum = 30) : maximum_vertices(maximum) {}
 
-  /// Solves the orientation problem on `g` with the signed edge weights
-  /// `weight` exactly and writes +1/-1 to `labels` for every vertex.
-  /// `Solver_report::iterations` is the number of states visited, summed
-  /// over the components (1 for a vertex without informative edges).
-  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
-  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
-  /// \tparam WeightMap a readable edge property map with a floating value
-  /// \tparam LabelMap a writable vertex property map accepting `Label`
-  /// \throw std::length_error if a connected component of the edges of
-  ///        non-zero weight has more than `maximum_vertices` vertices
-  /// \throw std::invalid_argument if a weight is not finite
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve
-  template <typename Graph, typename WeightMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
-  {
-    return solve_impl(g, weight, internal::No_unary(), labels);
-  }
-
-  /// Solves exactly the orientation problem with unary terms: minimises
-  /// E(L) = sum over the edges of `edge_energy(w_e, L_i, L_j)` + sum over the
-  /// vertices of the unary cost of L_i (see the `energy()` overload with a
-  /// `unary` map), and writes +1/-1 to `labels` for every vertex.  Unary
-  /// costs may be negative.  `Solver_report::iterations` is the number of
-  /// states visited, 2^k for a component of k vertices.
-  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
-  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
-  /// \tparam WeightMap a readable edge property map with a floating value
-  /// \tparam UnaryMap a readable vertex property map whose value has members
-  ///         `first` (the cost of label +1) and `second` (the cost of label
-  ///         -1) convertible to `double`, such as `std::pair<double, double>`
-  /// \tparam LabelMap a writable vertex property map accepting `Label`
-  /// \throw std::length_error if a connected component of the edges of
-  ///        non-zero weight has more than `maximum_vertices` vertices
-  /// \throw std::invalid_argument if a weight or a unary cost is not finite
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param unary the costs of the labels +1 (`first`) and -1 (`second`) of every vertex
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve (its energy includes the unary costs)
-  template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
-  {
-    return solve_impl(g, weight, unary, labels);
-  }
-
 private:
+  /// \cond SKIP_IN_MANUAL
+  friend class Orientation_solver_base<Exhaustive_solver>; // calls solve_impl()
+  /// \endcond
+
   /// the hard limit on the size of a component (states fit in 64 bits)
   static constexpr unsigned int hard_maximum_vertices = 62;
 
@@ -301,12 +267,7 @@ private:
     for (const Edge& e : informative)
       if ((label[e.u] == label[e.v]) != (e.w > 0.0))
         ++report.frustrated_edges;
-    if constexpr (with_unary)
-      report.energy = energy(g, weight, unary, labels);
-    else
-      report.energy = energy(g, weight, labels);
-    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return report;
+    return internal::complete_report(report, g, weight, unary, labels, start);
   }
 
   /// the incidence structure of one component in fixed point, by bit

@@ -11,6 +11,7 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/internal/Max_flow.h>
 #include <Normal_orientation/solvers/Mst_solver.h>
+#include <Normal_orientation/solvers/Orientation_solver_base.h>
 #include <Normal_orientation/solvers/Solver_report.h>
 
 #include <boost/graph/graph_traits.hpp>
@@ -99,13 +100,21 @@ namespace Normal_orientation {
 /// labelling is the best one seen and its energy is never above the
 /// starting MST labelling's.  The solver is deterministic.
 ///
+/// <b>Contract of `solve()`</b> (both calls, see `Orientation_solver_base`).
+/// The minimum is local.  Unary costs may be negative; with them the start
+/// is `initial.solve(g, weight, unary, ...)`, the unary terms are kept
+/// exactly in every sub-problem, only the components of the non-zero edges
+/// without unary terms (c+ = c- at all their vertices) get an anchor, and
+/// `Solver_report::energy` includes the unary costs.  Throws
+/// `std::invalid_argument` if a unary cost is not finite.
+///
 /// `Solver_report::iterations` counts the max-flows solved.
 ///
 /// Cost: O(V + E) to build each max-flow plus the flow computation, at most
 /// `maximum_iterations` times; memory about 16 bytes per edge for the
 /// terms plus the max-flow graph of the submodular edges.
 /// \cgalModels `OrientationSolver`
-class Lsa_tr_solver
+class Lsa_tr_solver : public Orientation_solver_base<Lsa_tr_solver>
 {
 public:
   /// the name used on the command line and in reports
@@ -140,88 +149,87 @@ public:
     : initial(start), maximum_iterations(iterations)
   {}
 
-  /// Solves the orientation problem on `g` with the signed edge weights
-  /// `weight` and writes +1/-1 to `labels` for every vertex.
-  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
-  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
-  /// \tparam WeightMap a readable edge property map with a floating value
-  /// \tparam LabelMap a writable vertex property map accepting `Label`
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve
-  template <typename Graph, typename WeightMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
-  {
-    return solve_impl(g, weight, internal::No_unary(), labels);
-  }
-
-  /// Solves the orientation problem with unary terms: minimises (locally)
-  /// E(L) = sum over the edges of `edge_energy(w_e, L_i, L_j)` + sum over the
-  /// vertices of the unary cost of L_i (see the `energy()` overload with a
-  /// `unary` map), and writes +1/-1 to `labels` for every vertex.  Unary
-  /// costs may be negative.  The start is `initial.solve(g, weight, unary,
-  /// ...)`, the unary terms are kept exactly in every sub-problem, and only
-  /// the components of the non-zero edges without unary terms (c+ = c- at
-  /// all their vertices) get an anchor (see the class description).
-  /// `Solver_report::energy` includes the unary costs.
-  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
-  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
-  /// \tparam WeightMap a readable edge property map with a floating value
-  /// \tparam UnaryMap a readable vertex property map whose value has members
-  ///         `first` (the cost of label +1) and `second` (the cost of label
-  ///         -1) convertible to `double`, such as `std::pair<double, double>`
-  /// \tparam LabelMap a writable vertex property map accepting `Label`
-  /// \throw std::invalid_argument if a unary cost is not finite
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param unary the costs of the labels +1 (`first`) and -1 (`second`) of every vertex
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve (its energy includes the unary costs)
-  template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
-  {
-    return solve_impl(g, weight, unary, labels);
-  }
-
 private:
+  /// \cond SKIP_IN_MANUAL
+  friend class Orientation_solver_base<Lsa_tr_solver>; // calls solve_impl()
+  /// \endcond
+
+  typedef internal::Max_flow::Index Index;
+
+  /// a pairwise term in z: c [z_u != z_v] (submodular) when c > 0, |c|
+  /// [z_u == z_v] (supermodular) when c < 0
+  struct Term
+  {
+    Index u, v;
+    double c;
+  };
+
+  /// the problem in z (z = 0 is the starting labelling y)
+  struct Permuted_problem
+  {
+    /// the pairwise terms, without loops and zero weights (constants)
+    std::vector<Term> terms;
+    /// the number of submodular terms
+    std::size_t submodular = 0;
+    /// with unary terms, modular[i] = (cost of z_i = 1) - (cost of z_i = 0)
+    std::vector<double> modular;
+    /// the sum of the negative modular terms, a lower bound of E(z)
+    double lower_bound = 0.0;
+  };
+
   /// The solve, without unary terms when `UnaryMap` is `internal::No_unary`.
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Solver_report solve_impl(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
   {
-    typedef internal::Max_flow::Index Index;
     constexpr bool with_unary = !std::is_same<UnaryMap, internal::No_unary>::value;
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = std::size_t(num_vertices(g));
-    auto index = get(boost::vertex_index, g);
 
-    // 1. Starting labelling y (z = 0), and with unary terms the modular term
-    //    of z: modular[i] = (cost of z_i = 1) - (cost of z_i = 0), whose
-    //    negative parts sum to a lower bound of E(z) (the edge terms are >= 0).
+    // 1-2. Starting labelling y (z = 0) and the terms in z.
     std::vector<Label> y(n, Label(1));
-    std::vector<double> modular;
-    double lower_bound = 0.0;
+    const Permuted_problem problem = permute<with_unary>(g, weight, unary, y);
+    const std::vector<unsigned char> anchor = component_anchors<with_unary>(g, weight, problem.modular);
+
+    // 3. Trust-region iterations.
+    Solver_report report;
+    const std::vector<unsigned char> z = trust_region<with_unary>(problem, anchor, report);
+
+    // 4. Output L_i = y_i, flipped where z_i = 1.
+    std::vector<Label> best(n);
+    for (std::size_t i = 0; i < n; ++i)
+      best[i] = z[i] ? Label(-y[i]) : y[i];
+    if constexpr (with_unary)
+      std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, unary, best, labels);
+    else
+      std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, best, labels);
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
+  }
+
+  /// Writes the starting labelling to `y` (`initial.solve()`) and returns
+  /// the problem in z.  With unary terms, the modular term of z is
+  /// modular[i] = (cost of z_i = 1) - (cost of z_i = 0), whose negative parts
+  /// sum to a lower bound of E(z) (the edge terms are >= 0).
+  template <bool with_unary, typename Graph, typename WeightMap, typename UnaryMap>
+  Permuted_problem permute(const Graph& g, WeightMap weight, const UnaryMap& unary, std::vector<Label>& y) const
+  {
+    const std::size_t n = y.size();
+    auto index = get(boost::vertex_index, g);
+    Permuted_problem p;
     if constexpr (with_unary) {
       const std::vector<std::pair<double, double>> costs = internal::unary_costs(g, unary, "Lsa_tr_solver");
       initial.solve(g, weight, unary, boost::make_iterator_property_map(y.begin(), index));
-      modular.resize(n);
+      p.modular.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
-        modular[i] = y[i] > 0 ? costs[i].second - costs[i].first : costs[i].first - costs[i].second;
-        lower_bound += std::min(0.0, modular[i]);
+        p.modular[i] = y[i] > 0 ? costs[i].second - costs[i].first : costs[i].first - costs[i].second;
+        p.lower_bound += std::min(0.0, p.modular[i]);
       }
     } else
       initial.solve(g, weight, boost::make_iterator_property_map(y.begin(), index));
 
-    // 2. The terms in z: c > 0 submodular, c < 0 supermodular.  Loops and
-    //    zero weights are constants and left out.
-    struct Term
-    {
-      Index u, v;
-      double c;
-    };
-    std::vector<Term> terms;
-    terms.reserve(std::size_t(num_edges(g)));
-    std::size_t submodular = 0;
+    // the terms in z: c > 0 submodular, c < 0 supermodular; loops and zero
+    // weights are constants and left out
+    p.terms.reserve(std::size_t(num_edges(g)));
     typename boost::graph_traits<Graph>::edge_iterator it, end;
     for (boost::tie(it, end) = edges(g); it != end; ++it) {
       const double w = double(get(weight, *it));
@@ -229,44 +237,20 @@ private:
       if (w == 0.0 || u == v)
         continue;
       const double c = (y[u] == y[v]) ? w : -w;
-      terms.push_back(Term{Index(u), Index(v), c});
-      submodular += (c > 0.0);
+      p.terms.push_back(Term{Index(u), Index(v), c});
+      p.submodular += (c > 0.0);
     }
+    return p;
+  }
 
-    // E(z) up to the constant of the loops and of the unary terms at y, and
-    // the approximation around zt
-    auto z_energy = [&](const std::vector<unsigned char>& z) {
-      double e = 0.0;
-      for (const Term& t : terms)
-        if ((t.c > 0.0) == (z[t.u] != z[t.v]))
-          e += std::abs(t.c);
-      if constexpr (with_unary)
-        for (std::size_t i = 0; i < n; ++i)
-          if (z[i])
-            e += modular[i];
-      return e;
-    };
-    auto approximate_energy = [&](const std::vector<unsigned char>& z, const std::vector<unsigned char>& zt) {
-      double e = 0.0;
-      for (const Term& t : terms) {
-        if (t.c > 0.0) {
-          if (z[t.u] != z[t.v])
-            e += t.c;
-        } else {
-          const double a = zt[t.u], b = zt[t.v];
-          e += -t.c * (1.0 - z[t.u] - z[t.v] + 2.0 * (z[t.u] * b + a * z[t.v] - a * b));
-        }
-      }
-      if constexpr (with_unary)
-        for (std::size_t i = 0; i < n; ++i)
-          if (z[i])
-            e += modular[i];
-      return e;
-    };
-
-    // one anchor per connected component, pinned to z = 0 (see
-    // `pin_component_anchors`), at a cost above any energy difference; a
-    // component with a unary term has no flip symmetry, hence no anchor
+  /// One anchor per connected component, pinned to z = 0 (see
+  /// `pin_component_anchors`); a component with a unary term has no flip
+  /// symmetry, hence no anchor.  Returns 1 at the anchors, 0 elsewhere.
+  template <bool with_unary, typename Graph, typename WeightMap>
+  std::vector<unsigned char> component_anchors(const Graph& g, WeightMap weight,
+                                               const std::vector<double>& modular) const
+  {
+    const std::size_t n = std::size_t(num_vertices(g));
     std::vector<unsigned char> anchor(n, 0);
     if (pin_component_anchors) {
       std::vector<std::uint32_t> component;
@@ -280,25 +264,76 @@ private:
         if (!seen[component[i]])
           seen[component[i]] = anchor[i] = 1;
     }
+    return anchor;
+  }
+
+  /// `e` plus, with unary terms, the modular terms of the z_i = 1, added
+  /// one by one in vertex order
+  template <bool with_unary>
+  static double with_modular(const Permuted_problem& p, const std::vector<unsigned char>& z, double e)
+  {
+    if constexpr (with_unary)
+      for (std::size_t i = 0; i < z.size(); ++i)
+        if (z[i])
+          e += p.modular[i];
+    return e;
+  }
+
+  /// E(z) up to the constant of the loops and of the unary terms at y
+  template <bool with_unary>
+  static double z_energy(const Permuted_problem& p, const std::vector<unsigned char>& z)
+  {
+    double e = 0.0;
+    for (const Term& t : p.terms)
+      if ((t.c > 0.0) == (z[t.u] != z[t.v]))
+        e += std::abs(t.c);
+    return with_modular<with_unary>(p, z, e);
+  }
+
+  /// the approximation of E(z) around `zt`, up to the same constant
+  template <bool with_unary>
+  static double approximate_energy(const Permuted_problem& p, const std::vector<unsigned char>& z,
+                                   const std::vector<unsigned char>& zt)
+  {
+    double e = 0.0;
+    for (const Term& t : p.terms) {
+      if (t.c > 0.0) {
+        if (z[t.u] != z[t.v])
+          e += t.c;
+      } else {
+        const double a = zt[t.u], b = zt[t.v];
+        e += -t.c * (1.0 - z[t.u] - z[t.v] + 2.0 * (z[t.u] * b + a * z[t.v] - a * b));
+      }
+    }
+    return with_modular<with_unary>(p, z, e);
+  }
+
+  /// The trust-region iterations from z = 0 (see the class description);
+  /// returns the last accepted z and counts the max-flows in
+  /// `report.iterations`.  Anchors are pinned at a cost above any energy
+  /// difference.
+  template <bool with_unary>
+  std::vector<unsigned char> trust_region(const Permuted_problem& p, const std::vector<unsigned char>& anchor,
+                                          Solver_report& report) const
+  {
+    const std::size_t n = anchor.size();
     double total = 0.0;
-    for (const Term& t : terms)
+    for (const Term& t : p.terms)
       total += std::abs(t.c);
 
     std::vector<unsigned char> z(n, 0), proposal(n, 0);
-    double current = z_energy(z);
+    double current = z_energy<with_unary>(p, z);
     double lambda = initial_lambda;
     std::vector<double> linear(n); // cost of z_i = 1 minus cost of z_i = 0
-    Solver_report report;
 
-    // 3. Trust-region iterations.
-    while (report.iterations < maximum_iterations && lambda <= maximum_lambda && current > lower_bound) {
+    while (report.iterations < maximum_iterations && lambda <= maximum_lambda && current > p.lower_bound) {
       if constexpr (with_unary)
-        std::copy(modular.begin(), modular.end(), linear.begin()); // exact
+        std::copy(p.modular.begin(), p.modular.end(), linear.begin()); // exact
       else
         std::fill(linear.begin(), linear.end(), 0.0);
-      internal::Max_flow flow(n, submodular);
+      internal::Max_flow flow(n, p.submodular);
       flow.add_nodes(n);
-      for (const Term& t : terms) {
+      for (const Term& t : p.terms) {
         if (t.c > 0.0)
           flow.add_edge(t.u, t.v, t.c, t.c);
         else {
@@ -323,8 +358,8 @@ private:
       }
       if (!moved)
         break; // z_t minimises the sub-problem for this lambda and every larger one
-      const double predicted = current - approximate_energy(proposal, z);
-      const double proposed = z_energy(proposal);
+      const double predicted = current - approximate_energy<with_unary>(p, proposal, z);
+      const double proposed = z_energy<with_unary>(p, proposal);
       const double actual = current - proposed;
       const double rho = predicted > 0.0 ? actual / predicted : 0.0;
       if (actual > 1e-12 * std::max(1.0, current)) {
@@ -336,17 +371,7 @@ private:
       else if (rho > 1.0 - reduction_ratio)
         lambda /= lambda_multiplier;
     }
-
-    // 4. Output L_i = y_i, flipped where z_i = 1.
-    std::vector<Label> best(n);
-    for (std::size_t i = 0; i < n; ++i)
-      best[i] = z[i] ? Label(-y[i]) : y[i];
-    if constexpr (with_unary)
-      std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, unary, best, labels);
-    else
-      std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, best, labels);
-    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return report;
+    return z;
   }
 };
 

@@ -9,6 +9,7 @@
 
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Signed_union_find.h>
+#include <Normal_orientation/solvers/Orientation_solver_base.h>
 #include <Normal_orientation/solvers/Solver_report.h>
 
 #include <boost/graph/graph_traits.hpp>
@@ -69,12 +70,21 @@ namespace Normal_orientation {
 /// conflicting constraints are decided by the forest, strongest first.
 /// With zero unary terms the labels are those of the solve without them.
 ///
+/// <b>Contract of `solve()`</b> (both calls, see `Orientation_solver_base`).
+/// The minimum is heuristic.  Unary costs may be negative; a vertex whose
+/// two costs are equal is unconstrained.  With unary terms,
+/// `Solver_report::energy` includes the unary costs,
+/// `Solver_report::iterations` counts the ground edges too, and
+/// `Solver_report::tree_edges` and `Solver_report::frustrated_edges` count
+/// the edges of `g` only.  Throws `std::invalid_argument` if a unary cost is
+/// not finite.
+///
 /// Cost: O(E) for the sort (radix), then O(E alpha(V)), then O(E) per sweep.
 /// Memory: about 24 bytes per edge and 7 bytes per vertex during the solve
 /// (with unary terms: plus about 40 bytes per vertex whose two costs
 /// differ, and 16 bytes per vertex while the costs are read).
 /// \cgalModels `OrientationSolver`
-class Mst_solver
+class Mst_solver : public Orientation_solver_base<Mst_solver>
 {
 public:
   /// the name used on the command line and in reports
@@ -87,51 +97,11 @@ public:
   /// the solver with `sweeps` sweeps of single-vertex moves
   explicit Mst_solver(unsigned int sweeps = 3) : local_sweeps(sweeps) {}
 
-  /// Solves the orientation problem on `g` with the signed edge weights
-  /// `weight` and writes +1/-1 to `labels` for every vertex.
-  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
-  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
-  /// \tparam WeightMap a readable edge property map with a floating value
-  /// \tparam LabelMap a writable vertex property map accepting `Label`
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve
-  template <typename Graph, typename WeightMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
-  {
-    return solve_impl(g, weight, internal::No_unary(), labels);
-  }
-
-  /// Solves the orientation problem with unary terms: minimises (heuristically)
-  /// E(L) = sum over the edges of `edge_energy(w_e, L_i, L_j)` + sum over the
-  /// vertices of the unary cost of L_i (see the `energy()` overload with a
-  /// `unary` map), and writes +1/-1 to `labels` for every vertex.  Unary
-  /// costs may be negative; a vertex whose two costs are equal is
-  /// unconstrained.  `Solver_report::energy` includes the unary costs,
-  /// `Solver_report::iterations` counts the ground edges too (see the class
-  /// description), `Solver_report::tree_edges` and
-  /// `Solver_report::frustrated_edges` count the edges of `g` only.
-  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
-  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
-  /// \tparam WeightMap a readable edge property map with a floating value
-  /// \tparam UnaryMap a readable vertex property map whose value has members
-  ///         `first` (the cost of label +1) and `second` (the cost of label
-  ///         -1) convertible to `double`, such as `std::pair<double, double>`
-  /// \tparam LabelMap a writable vertex property map accepting `Label`
-  /// \throw std::invalid_argument if a unary cost is not finite
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param unary the costs of the labels +1 (`first`) and -1 (`second`) of every vertex
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve (its energy includes the unary costs)
-  template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
-  {
-    return solve_impl(g, weight, unary, labels);
-  }
-
 private:
+  /// \cond SKIP_IN_MANUAL
+  friend class Orientation_solver_base<Mst_solver>; // calls solve_impl()
+  /// \endcond
+
   /// the top bit of `Sorted_edge::head`: the weight is negative
   static constexpr std::uint32_t negative_bit = 0x80000000u;
 
@@ -268,12 +238,7 @@ private:
       if ((label[e.tail] == label[v]) == negative)
         ++report.frustrated_edges;
     }
-    if constexpr (with_unary)
-      report.energy = energy(g, weight, unary, labels);
-    else
-      report.energy = energy(g, weight, labels);
-    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return report;
+    return internal::complete_report(report, g, weight, unary, labels, start);
   }
 
   /// the signed weight of `e`, as ranked (single precision)

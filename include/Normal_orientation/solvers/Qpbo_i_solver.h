@@ -11,6 +11,7 @@
 #include <Normal_orientation/internal/Graph_reduction.h>
 #include <Normal_orientation/internal/Qpbo.h>
 #include <Normal_orientation/solvers/Mst_solver.h>
+#include <Normal_orientation/solvers/Orientation_solver_base.h>
 #include <Normal_orientation/solvers/Solver_report.h>
 
 #include <boost/graph/graph_traits.hpp>
@@ -68,8 +69,14 @@ namespace Normal_orientation {
 /// edges to a ground vertex, QPBO as unary terms, and the segment graph as
 /// sums over the segments; constraints stronger than all the edges together
 /// are always met.
+///
+/// <b>Contract of `solve()`</b> (both calls, see `Orientation_solver_base`).
+/// `Solver_report::iterations` counts the fixes made over all orders.  A
+/// unary cost larger than the sum of all the |weights| makes the label of
+/// its vertex a hard constraint.  Throws `std::invalid_argument` if a
+/// weight or a unary cost is not finite.
 /// \cgalModels `OrientationSolver`
-class Qpbo_i_solver
+class Qpbo_i_solver : public Orientation_solver_base<Qpbo_i_solver>
 {
 public:
   /// the name used on the command line and in reports
@@ -119,42 +126,11 @@ public:
   /// instead of 30x.
   static std::size_t maximum_segments(std::size_t n) { return std::max<std::size_t>(4096, n / 32); }
 
-  /// Solves the orientation problem on `g` with the signed edge weights
-  /// `weight` and writes +1/-1 to `labels` for every vertex.
-  /// `Solver_report::iterations` counts the fixes made over all orders.
-  /// \tparam Graph a model of `VertexListGraph` and `EdgeListGraph` with an
-  ///         internal `vertex_index` map (vertex indices 0 ... n-1)
-  /// \tparam WeightMap a readable edge property map with a floating value
-  /// \tparam LabelMap a writable vertex property map accepting `Label`
-  /// \throw std::invalid_argument if a weight is not finite
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve
-  template <typename Graph, typename WeightMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, LabelMap labels) const
-  {
-    return solve_impl(g, weight, internal::No_unary(), labels);
-  }
-
-  /// The same with unary terms (see the `OrientationSolver` concept and
-  /// the `energy()` overload with a `unary` map, whose energy the report
-  /// gives): the unary map's values have members `first` and `second`, the
-  /// costs of the labels +1 and -1.  A cost larger than the sum of all the
-  /// |weights| makes the label of its vertex a hard constraint.
-  /// \throw std::invalid_argument if a weight or a unary cost is not finite
-  /// \param g the graph: one pairwise term per edge
-  /// \param weight the signed edge weights
-  /// \param unary the costs of the labels +1 (`first`) and -1 (`second`) of every vertex
-  /// \param labels receives the label (+1 or -1) of every vertex
-  /// \return the report of the solve (its energy includes the unary costs)
-  template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
-  Solver_report solve(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
-  {
-    return solve_impl(g, weight, unary, labels);
-  }
-
 private:
+  /// \cond SKIP_IN_MANUAL
+  friend class Orientation_solver_base<Qpbo_i_solver>; // calls solve_impl()
+  /// \endcond
+
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Solver_report solve_impl(const Graph& g, WeightMap weight, const UnaryMap& unary, LabelMap labels) const
   {
