@@ -15,10 +15,12 @@
 /// that is "nothing can be said".
 
 #include <Normal_orientation/internal/Konig_curves.h>
+#include <Normal_orientation/internal/Unit_vector.h>
 
 #include <CGAL/number_utils.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace Normal_orientation {
@@ -44,14 +46,9 @@ inline double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y +
 /// `v` is zero or not finite
 inline bool normalize(Vec3& v)
 {
-  const double l2 = dot(v, v);
-  if (!(l2 > 0.0) || !std::isfinite(l2)) {
-    v = Vec3{0.0, 0.0, 0.0};
-    return false;
-  }
-  const double inv = 1.0 / std::sqrt(l2);
-  v.x *= inv; v.y *= inv; v.z *= inv;
-  return true;
+  const std::array<double, 3> u = unit_vector(v.x, v.y, v.z);
+  v = Vec3{u[0], u[1], u[2]};
+  return u[0] != 0.0 || u[1] != 0.0 || u[2] != 0.0;
 }
 
 inline double clamp_unit(double x) { return std::min(1.0, std::max(-1.0, x)); }

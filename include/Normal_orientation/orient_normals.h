@@ -13,6 +13,7 @@
 #include <Normal_orientation/Orientation_result.h>
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/internal/Settings.h>
+#include <Normal_orientation/internal/Unit_vector.h>
 #include <Normal_orientation/parameters.h>
 #include <Normal_orientation/solvers/Mst_solver.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
@@ -26,6 +27,7 @@
 #include <tbb/task_arena.h>
 #endif
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -80,14 +82,10 @@ void copy_input(PointRange& points, const PointMap& point_map, const NormalMap& 
         throw std::invalid_argument(msg.str());
       }
     out.points.push_back(p);
-    const double l2 = c[3] * c[3] + c[4] * c[4] + c[5] * c[5];
-    if (l2 > 0.0) {
-      const double inv = 1.0 / std::sqrt(l2);
-      out.normals.push_back(Vector(c[3] * inv, c[4] * inv, c[5] * inv));
-    } else {
-      out.normals.push_back(Vector(0.0, 0.0, 0.0));
+    const std::array<double, 3> u = unit_vector(c[3], c[4], c[5]);
+    out.normals.push_back(Vector(u[0], u[1], u[2]));
+    if (u[0] == 0.0 && u[1] == 0.0 && u[2] == 0.0)
       ++result.number_of_zero_normals;
-    }
   }
   if constexpr (HasConstraints) {
     const auto cmap = CGAL::parameters::get_parameter(np, CGAL::internal_np::point_is_constrained);

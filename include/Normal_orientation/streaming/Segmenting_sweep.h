@@ -14,6 +14,7 @@
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Segmenter.h>
 #include <Normal_orientation/internal/Parallel.h>
+#include <Normal_orientation/internal/Unit_vector.h>
 #include <Normal_orientation/streaming/Record_file.h>
 #include <Normal_orientation/streaming/Refinement.h>
 #include <Normal_orientation/streaming/Sweep.h>
@@ -49,11 +50,7 @@ struct Sweep_payload
 /// unit normal of a record (zero when the normal is zero)
 inline std::array<double, 3> unit_normal(const Point_record& r)
 {
-  const double l2 = r.normal[0] * r.normal[0] + r.normal[1] * r.normal[1] + r.normal[2] * r.normal[2];
-  if (!(l2 > 0.0))
-    return {0.0, 0.0, 0.0};
-  const double inv = 1.0 / std::sqrt(l2);
-  return {r.normal[0] * inv, r.normal[1] * inv, r.normal[2] * inv};
+  return Normal_orientation::internal::unit_vector(r.normal[0], r.normal[1], r.normal[2]);
 }
 
 /// What the sweep stage leaves: the segmentation, per segment its size and
