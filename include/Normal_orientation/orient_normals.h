@@ -45,6 +45,50 @@ namespace Normal_orientation {
 /// \cond SKIP_IN_MANUAL
 namespace internal {
 
+/// Whether the named parameters `NamedParameters` carry constraints or priors.
+template <typename NamedParameters>
+struct Unary_parameters
+{
+  static constexpr bool has_constraints =
+    !CGAL::parameters::is_default_parameter<NamedParameters, CGAL::internal_np::point_is_constrained_t>::value;
+  static constexpr bool has_prior =
+    !CGAL::parameters::is_default_parameter<NamedParameters, internal_np::orientation_prior_map_t>::value;
+};
+
+/// The policies of a run, as both drivers read them.
+template <typename FlipCriterion, typename Solver, typename SignPolicy>
+struct Policies
+{
+  FlipCriterion criterion;
+  Solver solver;
+  SignPolicy sign_policy;
+  /// writes their names into `result`
+  void name(Orientation_summary& result) const
+  {
+    result.criterion = name_of(criterion);
+    result.solver = name_of(solver);
+    result.component_sign = name_of(sign_policy);
+  }
+};
+
+/// The flip criterion, the solver and the component sign policy of `np`,
+/// with the defaults of both drivers: `Hoppe_criterion`,
+/// `Qpbo_i_solver(3, seed)`, and `Outward_component_sign` (or
+/// `Constrained_component_sign<>` when there are constraints).
+template <typename NamedParameters>
+auto read_policies(const NamedParameters& np, unsigned long seed)
+{
+  using CGAL::parameters::choose_parameter;
+  using CGAL::parameters::get_parameter;
+  typedef std::conditional_t<Unary_parameters<NamedParameters>::has_constraints, Constrained_component_sign<>,
+                             Outward_component_sign>
+    Default_sign;
+  auto criterion = choose_parameter(get_parameter(np, internal_np::flip_criterion), Hoppe_criterion());
+  auto solver = choose_parameter(get_parameter(np, internal_np::solver), Qpbo_i_solver(3, seed));
+  auto sign_policy = choose_parameter(get_parameter(np, internal_np::component_sign), Default_sign());
+  return Policies<decltype(criterion), decltype(solver), decltype(sign_policy)>{criterion, solver, sign_policy};
+}
+
 /// The in-core copy of the input: positions, unit normals (zero where the
 /// input normal is zero), and the constraints and priors when given.
 template <typename Kernel>
@@ -296,8 +340,6 @@ template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag, typename Po
           typename NamedParameters = parameters::Default_named_parameters>
 Orientation_result orient_normals(PointRange& points, const NamedParameters& np = parameters::default_values())
 {
-  using CGAL::parameters::choose_parameter;
-  using CGAL::parameters::get_parameter;
   typedef CGAL::Point_set_processing_3_np_helper<PointRange, NamedParameters> NP_helper;
   typedef typename NP_helper::Geom_traits Kernel;
   static_assert(NP_helper::has_normal_map(), "orient_normals: the normal_map named parameter is required");
@@ -306,19 +348,15 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
   const auto point_map = NP_helper::get_point_map(points, np);
   const auto normal_map = NP_helper::get_normal_map(points, np);
   const internal::Settings settings = internal::read_settings(np, "orient_normals");
-  const auto criterion = choose_parameter(get_parameter(np, internal_np::flip_criterion), Hoppe_criterion());
-  const auto solver = choose_parameter(get_parameter(np, internal_np::solver), Qpbo_i_solver(3, settings.random_seed));
-  constexpr bool has_constraints =
-    !CGAL::parameters::is_default_parameter<NamedParameters, CGAL::internal_np::point_is_constrained_t>::value;
-  constexpr bool has_prior =
-    !CGAL::parameters::is_default_parameter<NamedParameters, internal_np::orientation_prior_map_t>::value;
-  typedef std::conditional_t<has_constraints, Constrained_component_sign<>, Outward_component_sign> Default_sign;
-  const auto sign_policy = choose_parameter(get_parameter(np, internal_np::component_sign), Default_sign());
+  const auto policies = internal::read_policies(np, settings.random_seed);
+  const auto& criterion = policies.criterion;
+  const auto& solver = policies.solver;
+  const auto& sign_policy = policies.sign_policy;
+  constexpr bool has_constraints = internal::Unary_parameters<NamedParameters>::has_constraints;
+  constexpr bool has_prior = internal::Unary_parameters<NamedParameters>::has_prior;
 
   Orientation_result result;
-  result.criterion = internal::name_of(criterion);
-  result.solver = internal::name_of(solver);
-  result.component_sign = internal::name_of(sign_policy);
+  policies.name(result);
 
   // 1. Copy and check the input; normals are normalised for the criteria.
   internal::Core_points<Kernel> in;

@@ -18,6 +18,7 @@
 #include <Normal_orientation/IO/Point_stream_transcode.h>
 #include <Normal_orientation/Point_record.h>
 #include <Normal_orientation/Progress.h>
+#include <Normal_orientation/orient_normals.h>
 #include <Normal_orientation/Segmenter.h>
 #include <Normal_orientation/internal/Settings.h>
 #include <Normal_orientation/parameters.h>
@@ -298,26 +299,20 @@ Streaming_result orient_stream(Source& source, Sink& sink, const NamedParameters
   Streaming_settings settings = read_streaming_settings(np, caller);
   if (hooks.adjust)
     hooks.adjust(settings);
-  const auto criterion = choose_parameter(get_parameter(np, inp::flip_criterion), Hoppe_criterion());
-  const auto solver = choose_parameter(get_parameter(np, inp::solver), Qpbo_i_solver(3, settings.random_seed));
-  constexpr bool has_constraints =
-    !CGAL::parameters::is_default_parameter<NamedParameters, CGAL::internal_np::point_is_constrained_t>::value;
-  constexpr bool has_prior =
-    !CGAL::parameters::is_default_parameter<NamedParameters, inp::orientation_prior_map_t>::value;
-  typedef std::conditional_t<has_constraints, Constrained_component_sign<>, Outward_component_sign> Default_sign;
-  const auto sign_policy = choose_parameter(get_parameter(np, inp::component_sign), Default_sign());
+  const auto policies = Normal_orientation::internal::read_policies(np, settings.random_seed);
+  constexpr bool has_constraints = Normal_orientation::internal::Unary_parameters<NamedParameters>::has_constraints;
+  constexpr bool has_prior = Normal_orientation::internal::Unary_parameters<NamedParameters>::has_prior;
   const auto constrained = choose_parameter(get_parameter(np, CGAL::internal_np::point_is_constrained), false);
   const auto prior = choose_parameter(get_parameter(np, inp::orientation_prior_map), false);
   Record_unary<std::decay_t<decltype(constrained)>, std::decay_t<decltype(prior)>, has_constraints, has_prior> unary{
     constrained, prior, 1.0};
 
   Streaming_result result;
-  result.criterion = Normal_orientation::internal::name_of(criterion);
-  result.solver = Normal_orientation::internal::name_of(solver);
-  result.component_sign = Normal_orientation::internal::name_of(sign_policy);
+  policies.name(result);
   try {
     Normal_orientation::internal::run_with_threads(settings.number_of_threads, [&]() {
-      run_stages<ConcurrencyTag, Kernel>(source, sink, settings, criterion, solver, sign_policy, unary, hooks, result);
+      run_stages<ConcurrencyTag, Kernel>(source, sink, settings, policies.criterion, policies.solver,
+                                         policies.sign_policy, unary, hooks, result);
     });
   } catch (const Interrupted&) {
     result.interrupted = true;
