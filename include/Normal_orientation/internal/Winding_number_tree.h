@@ -46,6 +46,14 @@ struct Winding_node
   double third[18];   // Q[kl][j] = sum a_i (p_i - c)_k (p_i - c)_l (s_i n_i)_j, kl in 00 01 02 11 12 22
 };
 
+/// The charges of one node for `Winding_tree::charge_field()`: their sum
+/// and their first moment about the node's centre.
+struct Charge_node
+{
+  double charge = 0.0;
+  double moment[3] = {0.0, 0.0, 0.0};
+};
+
 /// the index in `Winding_node::third` of the symmetric pair (k, l)
 inline int winding_pair(int k, int l)
 {
@@ -155,6 +163,8 @@ public:
     while ((n + (std::size_t(1) << depth_) - 1) >> depth_ > leaf_size)
       ++depth_;
     nodes_.assign(n == 0 ? 0 : (std::size_t(2) << depth_) - 1, Winding_node());
+    charges_.clear();
+    position_charge_.clear();
     if (n > 0)
       build_node<ConcurrencyTag>(0, 0, 0);
     position_.assign(n, 0);
@@ -238,7 +248,88 @@ public:
     add_samples<Gradient>(q, f2, 0, samples_.size(), w, g);
   }
 
+  /// Sets the charges q_t of the samples, given by input index, for
+  /// `charge_field()`: every node keeps their sum and their first moment
+  /// sum q_t (p_t - c) about its centre.
+  void set_charges(const std::vector<double>& charge_by_index)
+  {
+    charges_.assign(nodes_.size(), Charge_node());
+    position_charge_.assign(samples_.size(), 0.0);
+    for (std::size_t t = 0; t < samples_.size(); ++t)
+      position_charge_[t] = charge_by_index[samples_[t].index];
+    if (nodes_.empty())
+      return;
+    const std::size_t first_leaf = (std::size_t(1) << depth_) - 1;
+    for (std::size_t i = nodes_.size(); i-- > 0;) {
+      Charge_node& c = charges_[i];
+      const Winding_node& node = nodes_[i];
+      if (i >= first_leaf) {
+        const std::size_t j = i - first_leaf;
+        for (std::size_t t = range_begin(depth_, j); t < range_begin(depth_, j + 1); ++t) {
+          const double q = position_charge_[t];
+          c.charge += q;
+          for (int k = 0; k < 3; ++k)
+            c.moment[k] += q * (samples_[t].p[k] - node.center[k]);
+        }
+      } else {
+        for (std::size_t h = 2 * i + 1; h <= 2 * i + 2; ++h) {
+          const Charge_node& child = charges_[h];
+          c.charge += child.charge;
+          for (int k = 0; k < 3; ++k)
+            c.moment[k] += child.moment[k] + child.charge * (nodes_[h].center[k] - node.center[k]);
+        }
+      }
+    }
+  }
+
+  /// F(x) = sum_t q_t (x - p_t) / (|x - p_t|^2 + e2)^(3/2) by the treecode
+  /// (nodes to first order, opened as in `evaluate()`), with the charges of
+  /// `set_charges()`: the derivative of sum_t q_t w(p_t) with respect to the
+  /// moment a s n of a sample at x with smoothing e2, times 4 pi.
+  void charge_field(const double x[3], double beta2, double e2, double F[3]) const
+  {
+    F[0] = F[1] = F[2] = 0.0;
+    if (nodes_.empty() || charges_.size() != nodes_.size())
+      return;
+    const std::size_t first_leaf = (std::size_t(1) << depth_) - 1;
+    std::size_t stack[128];
+    std::size_t top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const std::size_t i = stack[--top];
+      const Winding_node& node = nodes_[i];
+      const double R[3] = {node.center[0] - x[0], node.center[1] - x[1], node.center[2] - x[2]};
+      const double dist2 = R[0] * R[0] + R[1] * R[1] + R[2] * R[2];
+      if (dist2 > beta2 * node.radius * node.radius) {
+        // F = -Q R / d^3 - D / d^3 + 3 (D . R) R / d^5, with R = c - x
+        const Charge_node& c = charges_[i];
+        const double d2 = dist2 + e2;
+        const double inv_d3 = 1.0 / (d2 * std::sqrt(d2));
+        const double DR = c.moment[0] * R[0] + c.moment[1] * R[1] + c.moment[2] * R[2];
+        for (int k = 0; k < 3; ++k)
+          F[k] += (-c.charge * R[k] - c.moment[k] + 3.0 * DR * R[k] / d2) * inv_d3;
+      } else if (i >= first_leaf) {
+        const std::size_t j = i - first_leaf;
+        for (std::size_t t = range_begin(depth_, j); t < range_begin(depth_, j + 1); ++t) {
+          const Winding_sample& s = samples_[t];
+          const double r[3] = {x[0] - s.p[0], x[1] - s.p[1], x[2] - s.p[2]};
+          const double d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + e2;
+          if (!(d2 > 0.0))
+            continue;
+          const double f = charge_of_position(t) / (d2 * std::sqrt(d2));
+          for (int k = 0; k < 3; ++k)
+            F[k] += f * r[k];
+        }
+      } else {
+        stack[top++] = 2 * i + 2;
+        stack[top++] = 2 * i + 1;
+      }
+    }
+  }
+
 private:
+  double charge_of_position(std::size_t t) const { return position_charge_[t]; }
+
   std::size_t range_begin(unsigned int d, std::size_t j) const
   {
     return std::size_t(std::uint64_t(j) * std::uint64_t(samples_.size()) >> d);
@@ -392,6 +483,8 @@ private:
   std::vector<Winding_sample> samples_; // in tree order
   std::vector<std::uint32_t> position_;  // input index -> tree position
   std::vector<Winding_node> nodes_;      // heap layout
+  std::vector<Charge_node> charges_;     // heap layout, from set_charges()
+  std::vector<double> position_charge_;  // by tree position, from set_charges()
   unsigned int depth_ = 0;
 };
 
