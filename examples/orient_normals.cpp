@@ -183,7 +183,10 @@ template <typename Range, typename Np>
 NO::Orientation_result orient_in_core(Range& range, const Np& np, const Cli::Options& o, std::vector<double>& prior)
 {
   return with_criterion_and_solver(o, [&](const auto& criterion, const auto& solver) {
-    const auto policies = np.flip_criterion(criterion).solver(solver).component_sign(Cli::Component_sign(o));
+    const auto policies = np.flip_criterion(criterion)
+                            .solver(solver)
+                            .component_sign(Cli::Component_sign(o))
+                            .global_orientation(Cli::global_orientation(o));
     if (!prior.empty())
       return NO::orient_normals(range, policies.orientation_prior_map(CGAL::make_property_map(prior)));
     return NO::orient_normals(range, policies);
@@ -307,7 +310,10 @@ Cli::Streamed_run orient_streamed(const Cli::Options& o, Cli::Progress_bar& bar)
     return NO::streaming_orient_files(o.input, o.output, policies, wo);
   };
   run.result = with_criterion_and_solver(o, [&](const auto& criterion, const auto& solver) {
-    const auto policies = np.flip_criterion(criterion).solver(solver).component_sign(Cli::Component_sign(o));
+    const auto policies = np.flip_criterion(criterion)
+                            .solver(solver)
+                            .component_sign(Cli::Component_sign(o))
+                            .global_orientation(Cli::global_orientation(o));
     if (o.prior_weight > 0.0)
       return orient(policies.orientation_prior_map(
         Cli::Record_viewpoint_prior{{{o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]}}, o.prior_weight}));

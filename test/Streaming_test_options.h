@@ -28,6 +28,7 @@ struct Stream_options
   std::uint64_t minimum_component_size = 0;
   Component_files_options component_files;
   std::function<bool(const Progress_info&)> callback;
+  Global_orientation global = Global_orientation::WINDING;
 };
 
 /// \brief `o` as named parameters
@@ -42,7 +43,8 @@ inline auto params(const Stream_options& o)
     .refinement_rounds(o.refinement_rounds)
     .minimum_component_size(o.minimum_component_size)
     .component_files(o.component_files)
-    .callback(o.callback);
+    .callback(o.callback)
+    .global_orientation(o.global);
 }
 
 } // namespace test

@@ -404,7 +404,7 @@ TEST(Streaming_progress, ReportsEveryStageInOrderAndCancels)
   const NO::Stage order[] = {NO::Stage::SCAN,   NO::Stage::RADIUS,
                                        NO::Stage::SORT,   NO::Stage::SWEEP,
                                        NO::Stage::SOLVE,  NO::Stage::REFINE,
-                                       NO::Stage::SIGN,   NO::Stage::OUTPUT};
+                                       NO::Stage::SIGN,   NO::Stage::GLOBAL, NO::Stage::OUTPUT};
   auto check_log = [&](const std::vector<NO::Stage>& expected) {
     std::vector<NO::Stage> stages;
     for (std::size_t i = 0; i < log.size(); ++i) {
@@ -447,7 +447,7 @@ TEST(Streaming_progress, ReportsEveryStageInOrderAndCancels)
     stream(source, po, out);
   }
   check_log({NO::Stage::SCAN, NO::Stage::SWEEP, NO::Stage::SOLVE,
-             NO::Stage::REFINE, NO::Stage::SIGN, NO::Stage::OUTPUT,
+             NO::Stage::REFINE, NO::Stage::SIGN, NO::Stage::GLOBAL, NO::Stage::OUTPUT,
              NO::Stage::COMPONENTS});
 
   // cancelled half way through the sweep: interrupted, nothing sunk, nothing left

@@ -230,6 +230,7 @@ TEST(Streaming_refinement, NeverRaisesTheEnergyAndReportsItExactly)
     options.refinement_rounds = rounds;
     options.radius = 0.12;
     options.batch_size = 3000;
+    options.global = NO::Global_orientation::NONE; // the refinement's own energy
     std::vector<Point_record> out;
     const NO::Streaming_result r = stream(source, options, out);
     ASSERT_EQ(out.size(), n);
@@ -268,6 +269,7 @@ TEST(Streaming_refinement, NeverRaisesTheEnergyAndReportsItExactly)
     options.refinement_rounds = 3;
     options.radius = 0.12;
     options.batch_size = 700;
+    options.global = NO::Global_orientation::NONE;
     std::vector<Point_record> out;
     auto sink = [&out](const Point_record& r) { out.push_back(r); };
     NO::streaming_orient_normals<CGAL::Sequential_tag>(source, sink, params(options));

@@ -43,6 +43,7 @@ struct Options
   bool has_viewpoint = false;          ///< --viewpoint was given
   double viewpoint[3] = {0, 0, 0};     ///< --viewpoint
   double prior_weight = 0.0;           ///< --prior-weight (0: no prior)
+  std::string global = "auto";         ///< --global: auto, winding or none
   std::string normals = "jet";         ///< --normals
   unsigned int normal_k = 18;          ///< --normal-k
   int threads = 0;                     ///< --threads (0: all cores)
@@ -85,6 +86,9 @@ inline const char* usage_text()
          "  --prior-weight W     with --viewpoint: also a soft prior for every point to face\n"
          "                       it, of weight W * cos(angle) (edges weigh at most 1), which\n"
          "                       every solver weighs against the edges (default 0: none)\n"
+         "  --global NAME        global sign stage: winding (the winding number of the cloud\n"
+         "                       decides the signs of patches where it is closed) or none;\n"
+         "                       default auto: winding with the outward sign and no viewpoint\n"
          "  --normals NAME       estimator when IN has no normals: jet (default), pca\n"
          "  --normal-k N         neighbours of the normal estimator (default 18)\n"
          "  --threads N          at most N threads (default, or 0: all cores); the output\n"
@@ -179,6 +183,10 @@ bool read_option(Options& o, const std::string& a, const Value& value)
     o.sign_given = true;
     if (o.sign != "outward" && o.sign != "keep")
       throw Usage_error("unknown sign policy '" + o.sign + "' (outward, keep)");
+  } else if (a == "--global") {
+    o.global = value();
+    if (o.global != "auto" && o.global != "winding" && o.global != "none")
+      throw Usage_error("unknown global stage '" + o.global + "' (auto, winding, none)");
   } else if (a == "--viewpoint") {
     std::string v = value();
     for (char& c : v)

@@ -54,6 +54,36 @@ inline void print_wrote(const std::string& path, const char* prefix = "wrote ")
 
 inline const char* plural(std::size_t n) { return n == 1 ? "" : "s"; }
 
+/// one line on what the global sign stage saw and did, when it ran
+inline void print_global(const Normal_orientation::Global_sign_summary& g)
+{
+  if (g.ran)
+    std::fprintf(stderr,
+                 "global stage (winding): %zu patch%s, %zu flipped; closedness %.3f, %zu closed and %zu open "
+                 "component%s, %.3f s\n",
+                 g.number_of_patches, g.number_of_patches == 1 ? "" : "es", g.patches_flipped, g.closedness,
+                 g.closed_components, g.open_components, plural(g.open_components), g.seconds);
+}
+
+/// "global": what the global sign stage saw and did (null when it did not run)
+inline void json_global(Json_writer& j, const Normal_orientation::Global_sign_summary& g)
+{
+  j.key("global");
+  if (!g.ran) {
+    j.null();
+    return;
+  }
+  j.begin_object();
+  j.key("stage").string("winding").key("closedness").number(g.closedness);
+  j.key("samples").integer(g.number_of_samples).key("patches").integer(g.number_of_patches);
+  j.key("patches_flipped").integer(g.patches_flipped).key("points_flipped").integer(g.points_flipped);
+  j.key("closed_components").integer(g.closed_components).key("open_components").integer(g.open_components);
+  j.key("rounds").integer(g.rounds);
+  j.key("energy_before").number(g.energy_before).key("energy_after").number(g.energy_after);
+  j.key("seconds").fixed(g.seconds);
+  j.end_object();
+}
+
 } // namespace internal
 /// \endcond
 
@@ -68,6 +98,7 @@ inline void print_summary(const Normal_orientation::Orientation_result& r, const
                r.number_of_neighbors, r.neighbor_radius, r.number_of_components,
                internal::plural(r.number_of_components), r.energy_before, r.energy_after, r.number_of_flipped,
                run.total_seconds);
+  internal::print_global(r.global);
   if (r.number_of_zero_normals > 0)
     std::fprintf(stderr, "%llu of %llu points have a zero normal: left as they were\n",
                  (unsigned long long)r.number_of_zero_normals, (unsigned long long)r.number_of_points);
@@ -95,10 +126,11 @@ inline std::string json_report(const Normal_orientation::Orientation_result& r, 
   j.key("frustrated_edges").integer(r.frustrated_edges).key("segments").integer(r.number_of_segments);
   j.key("unary_terms").integer(r.number_of_unary_terms).key("flipped").integer(r.number_of_flipped);
   j.key("zero_normals").integer(r.number_of_zero_normals);
+  internal::json_global(j, r.global);
   j.key("seconds").begin_object();
   j.key("read").fixed(run.read_seconds).key("estimate_normals").fixed(run.estimate_seconds);
   j.key("neighbors").fixed(r.seconds.neighbors).key("graph").fixed(r.seconds.graph);
-  j.key("solve").fixed(r.seconds.solve).key("sign").fixed(r.seconds.sign);
+  j.key("solve").fixed(r.seconds.solve).key("sign").fixed(r.seconds.sign).key("global").fixed(r.seconds.global);
   j.key("orient_total").fixed(r.seconds.total).key("write").fixed(run.write_seconds);
   j.key("total").fixed(run.total_seconds);
   j.end_object();
@@ -117,6 +149,7 @@ inline void print_summary(const Streamed_run& run, const Options& o)
                (unsigned long long)r.number_of_edges, o.k, r.neighbor_radius, r.number_of_segments,
                r.number_of_components, internal::plural(r.number_of_components), r.peak_window,
                (unsigned long long)r.number_of_flipped, run.total_seconds);
+  internal::print_global(r.global);
   if (r.number_of_dropped_components > 0)
     std::fprintf(stderr, "dropped %zu component%s of fewer than %llu points (%llu points)\n",
                  r.number_of_dropped_components, internal::plural(r.number_of_dropped_components),
@@ -162,11 +195,12 @@ inline std::string json_report(const Streamed_run& run, const Options& o)
   j.key("component_sign").string(r.component_sign).key("unary_terms").integer(r.number_of_unary_terms);
   j.key("zero_normals").integer(r.number_of_zero_normals);
   j.key("energy_before").number(r.energy_before).key("energy_after").number(r.energy_after);
+  internal::json_global(j, r.global);
   j.key("seconds").begin_object();
   j.key("frame").fixed(r.seconds.frame).key("radius").fixed(r.seconds.radius);
   j.key("sort").fixed(r.seconds.sort).key("sweep").fixed(r.seconds.sweep);
   j.key("solve").fixed(r.seconds.solve).key("refine").fixed(r.seconds.refine);
-  j.key("sign").fixed(r.seconds.sign).key("output").fixed(r.seconds.output);
+  j.key("sign").fixed(r.seconds.sign).key("global").fixed(r.seconds.global).key("output").fixed(r.seconds.output);
   j.key("components").fixed(r.seconds.components).key("total").fixed(run.total_seconds);
   j.end_object();
   j.end_object();

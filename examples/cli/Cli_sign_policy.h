@@ -12,6 +12,7 @@
 #include "Cli_options.h"
 
 #include <Normal_orientation/Component_sign.h>
+#include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Point_record.h>
 
 #include <boost/property_map/property_map.hpp>
@@ -88,6 +89,16 @@ private:
   Mode m_mode;
   Normal_orientation::Viewpoint_component_sign m_viewpoint;
 };
+
+/// The global stage of --global: `WINDING` for "winding", and for "auto"
+/// when the components face outward (no --viewpoint, no --sign keep);
+/// `NONE` otherwise.
+inline Normal_orientation::Global_orientation global_orientation(const Options& o)
+{
+  const bool automatic = o.global == "auto" && !o.has_viewpoint && o.sign == "outward" && o.prior_weight == 0.0;
+  return o.global == "winding" || automatic ? Normal_orientation::Global_orientation::WINDING
+                                            : Normal_orientation::Global_orientation::NONE;
+}
 
 /// a_i = W cos(angle between n_i and p_i -> viewpoint), or 0 when n_i or
 /// p_i -> viewpoint is zero: the prior of --prior-weight W

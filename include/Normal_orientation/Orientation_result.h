@@ -9,9 +9,30 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 
 namespace Normal_orientation {
+
+/// \ingroup PkgNormalOrientationGlobal
+/// What the global sign stage (`decide_patch_signs()`) saw and did.
+struct Global_sign_summary
+{
+  bool ran = false;                    ///< false when the stage was off or had nothing to decide
+  std::size_t number_of_samples = 0;   ///< points the field was built on (a subsample of large clouds)
+  std::size_t number_of_patches = 0;   ///< patches whose signs were decided
+  std::size_t patches_flipped = 0;     ///< patches the stage negated
+  std::uint64_t points_flipped = 0;    ///< points of those patches
+  std::size_t closed_components = 0;   ///< components found closed: the stage's signs were kept there
+  std::size_t open_components = 0;     ///< components found open: the stage left them as they were
+  unsigned int rounds = 0;             ///< rounds of patch flips
+  /// the fraction of the sampled area where w is within the tolerance of
+  /// 1/2, after the stage: near 1 on closed surfaces, low on open scans
+  double closedness = std::numeric_limits<double>::quiet_NaN();
+  double energy_before = std::numeric_limits<double>::quiet_NaN(); ///< sum a_j (w_j - 1/2)^2 before the stage
+  double energy_after = std::numeric_limits<double>::quiet_NaN();  ///< the same after it
+  double seconds = 0.0;                ///< the stage's wall-clock time
+};
 
 /// \ingroup PkgNormalOrientationRef
 /// The figures that both `orient_normals()` and `streaming_orient_normals()`
@@ -27,13 +48,16 @@ struct Orientation_summary
   double neighbor_radius = 0.0;            ///< r used
   bool radius_estimated = false;           ///< true when r was estimated from the data
   double energy_before = 0.0;              ///< energy (eq. 3) of the point graph with the input orientation
-  double energy_after = 0.0;               ///< energy of the point graph with the output orientation
+  /// energy of the point graph with the output orientation (streamed: NaN,
+  /// not measured, when the global stage negated segments of a refined labelling)
+  double energy_after = 0.0;
   std::size_t number_of_segments = 0;      ///< vertices of the segment graph the solver worked on (0: none)
   std::uint64_t number_of_unary_terms = 0; ///< points with a constraint or a non-zero prior
   std::string criterion;                   ///< the flip criterion's name
   std::string solver;                      ///< the solver's name
   std::string component_sign;              ///< the component sign policy's name
   bool interrupted = false;                ///< true when the callback stopped the run (nothing was written)
+  Global_sign_summary global;              ///< the global sign stage
 };
 
 /// \ingroup PkgNormalOrientationRef
@@ -44,7 +68,8 @@ struct Stage_seconds
   double neighbors = 0.0; ///< kd-tree and k-nearest-neighbour queries
   double graph = 0.0;     ///< edge weights and graph assembly
   double solve = 0.0;     ///< the solver
-  double sign = 0.0;      ///< components and their global signs
+  double sign = 0.0;      ///< components and their signs
+  double global = 0.0;    ///< the global sign stage
   double output = 0.0;    ///< writing the normals back
   double total = 0.0;     ///< the whole call
 };

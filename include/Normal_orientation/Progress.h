@@ -23,7 +23,7 @@ namespace Normal_orientation {
 
 /// \ingroup PkgNormalOrientationRef
 /// The stages of both drivers, in the order they run (each driver runs
-/// some of them: in core `INPUT`, `GRAPH`, `SOLVE`, `SIGN`;
+/// some of them: in core `INPUT`, `GRAPH`, `SOLVE`, `SIGN`, `GLOBAL`;
 /// streamed `SCAN` to `COMPONENTS`).
 enum class Stage
 {
@@ -36,19 +36,20 @@ enum class Stage
   SOLVE,     ///< the solver (streamed: on the segment graph)
   REFINE,    ///< streamed: the refinement passes
   SIGN,      ///< the sign of every connected component
+  GLOBAL,    ///< the global sign stage (the winding number of the cloud)
   OUTPUT,    ///< the oriented normals written back or handed to the sink
   COMPONENTS ///< streamed: the files of the components
 };
 
 /// \ingroup PkgNormalOrientationRef
 /// The lower-case name of `stage` ("input", "graph", "scan", "radius",
-/// "sort", "sweep", "solve", "refine", "sign", "output", "components").
+/// "sort", "sweep", "solve", "refine", "sign", "global", "output", "components").
 /// \param stage the stage
 /// \return a string literal
 inline const char* stage_name(Stage stage)
 {
-  static const char* const names[] = {"input", "graph",  "scan", "radius", "sort",      "sweep",
-                                      "solve", "refine", "sign", "output", "components"};
+  static const char* const names[] = {"input",  "graph", "scan",   "radius", "sort",      "sweep",
+                                      "solve",  "refine", "sign", "global", "output", "components"};
   const int i = int(stage);
   return i >= 0 && i < int(sizeof(names) / sizeof(names[0])) ? names[i] : "?";
 }

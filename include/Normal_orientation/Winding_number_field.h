@@ -437,6 +437,47 @@ public:
     run<ConcurrencyTag, true, true>(queries, values, &gradients);
   }
 
+  /// The moment a_i s_i n_i of point i (area times signed unit normal).
+  Vector_3 moment(std::size_t i) const
+  {
+    const internal::Winding_sample& s = sample(i);
+    return Vector_3(s.an[0], s.an[1], s.an[2]);
+  }
+
+  /// The adjoint of the field at the points: given a weight c_j per point
+  /// (in the order of `build()`), sets `derivatives[i]` to the derivative
+  /// of J = sum_j c_j w(p_j) with respect to the moment a_i n_i of point i,
+  ///
+  ///   v_i = 1/(4 pi) sum_j c_j (p_i - p_j) / (|p_i - p_j|^2 + eps_i^2)^(3/2),
+  ///
+  /// by a treecode over the same tree (charge sums and their first
+  /// moments, opened with the same ratio).  So the part of J due to a
+  /// set of points P is sum_{i in P} `moment(i)` . v_i, and negating P
+  /// changes J by -2 times that: one pass gives the effect on J of
+  /// negating every patch.  Deterministic for any number of threads.
+  /// \tparam ConcurrencyTag `CGAL::Parallel_tag` or `CGAL::Sequential_tag`
+  template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
+  void moment_derivatives(const std::vector<double>& weights, std::vector<Vector_3>& derivatives)
+  {
+    const std::size_t n = size();
+    if (weights.size() != n)
+      throw std::invalid_argument("Winding_number_field::moment_derivatives: one weight per point is needed");
+    for (double c : weights)
+      if (!std::isfinite(c))
+        throw std::invalid_argument("Winding_number_field::moment_derivatives: a weight is not finite");
+    tree_.set_charges(weights);
+    derivatives.assign(n, Vector_3(0, 0, 0));
+    const double beta2 = beta_ * beta_, f2 = factor_ * factor_, s = inv_4pi();
+    const auto& samples = tree_.samples();
+    internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) { // in tree order: coherent
+        double F[3];
+        tree_.charge_field(samples[t].p, beta2, f2 * samples[t].area, F);
+        derivatives[samples[t].index] = Vector_3(F[0] * s, F[1] * s, F[2] * s);
+      }
+    }, 64);
+  }
+
 private:
   static double inv_4pi() { return 0.25 / 3.14159265358979323846; }
 

@@ -12,6 +12,7 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Orientation_result.h>
 #include <Normal_orientation/Progress.h>
+#include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/internal/Settings.h>
 #include <Normal_orientation/internal/Unit_vector.h>
 #include <Normal_orientation/parameters.h>
@@ -62,6 +63,7 @@ struct Policies
   FlipCriterion criterion;
   Solver solver;
   SignPolicy sign_policy;
+  Global_orientation global;
   /// writes their names into `result`
   void name(Orientation_summary& result) const
   {
@@ -71,10 +73,13 @@ struct Policies
   }
 };
 
-/// The flip criterion, the solver and the component sign policy of `np`,
-/// with the defaults of both drivers: `Hoppe_criterion`,
-/// `Qpbo_i_solver(3, seed)`, and `Outward_component_sign` (or
-/// `Constrained_component_sign<>` when there are constraints).
+/// The flip criterion, the solver, the component sign policy and the
+/// global stage of `np`, with the defaults of both drivers:
+/// `Hoppe_criterion`, `Qpbo_i_solver(3, seed)`, `Outward_component_sign`
+/// (or `Constrained_component_sign<>` when there are constraints), and
+/// `Global_orientation::WINDING` when the sign policy is the default and
+/// there are no constraints or priors (which say what the user wants),
+/// `Global_orientation::NONE` otherwise.
 template <typename NamedParameters>
 auto read_policies(const NamedParameters& np, unsigned long seed)
 {
@@ -86,7 +91,14 @@ auto read_policies(const NamedParameters& np, unsigned long seed)
   auto criterion = choose_parameter(get_parameter(np, internal_np::flip_criterion), Hoppe_criterion());
   auto solver = choose_parameter(get_parameter(np, internal_np::solver), Qpbo_i_solver(3, seed));
   auto sign_policy = choose_parameter(get_parameter(np, internal_np::component_sign), Default_sign());
-  return Policies<decltype(criterion), decltype(solver), decltype(sign_policy)>{criterion, solver, sign_policy};
+  constexpr bool user_signs = Unary_parameters<NamedParameters>::has_constraints
+                              || Unary_parameters<NamedParameters>::has_prior
+                              || !CGAL::parameters::is_default_parameter<NamedParameters,
+                                                                         internal_np::component_sign_t>::value;
+  const Global_orientation global = choose_parameter(get_parameter(np, internal_np::global_orientation),
+                                                     user_signs ? Global_orientation::NONE : Global_orientation::WINDING);
+  return Policies<decltype(criterion), decltype(solver), decltype(sign_policy)>{criterion, solver, sign_policy,
+                                                                                 global};
 }
 
 /// The in-core copy of the input: positions, unit normals (zero where the
@@ -242,7 +254,9 @@ Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, Weig
 /// w_ij = phi(i, j) * (1 - d_ij^2 / r^2) from a flip criterion; a solver
 /// minimising the energy of eq. 3 over the labels L_i in {+1, -1}; then a
 /// component sign policy fixes the free sign of every connected component;
-/// finally n_i <- L_i n_i through the normal map.
+/// then, by default, the global sign stage lets the winding number of the
+/// cloud decide the signs of patches where it is closed (touching and
+/// nested objects, flat faces); finally n_i <- L_i n_i through the normal map.
 ///
 /// The input order is never changed and only the sign of normals changes
 /// (their length and direction are kept exactly).  Zero normals are left
@@ -296,6 +310,13 @@ Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, Weig
 ///   \cgalParamNBegin{component_sign}
 ///     \cgalParamDescription{a model of `ComponentSignPolicy`}
 ///     \cgalParamDefault{`Outward_component_sign()`, or `Constrained_component_sign<>()` when `point_is_constrained_map` is given}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{global_orientation}
+///     \cgalParamDescription{the global sign stage after the component signs: the winding number of the
+///       whole cloud decides the signs of patches where it is closed (see `decide_patch_signs()`)}
+///     \cgalParamType{`Global_orientation`}
+///     \cgalParamDefault{`Global_orientation::WINDING` with the default `component_sign` and without
+///       constraints or priors, `Global_orientation::NONE` otherwise}
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{point_is_constrained_map}
 ///     \cgalParamDescription{points whose input normal is known to be correctly oriented: hard
@@ -417,11 +438,20 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       for (std::size_t i = 0; i < n; ++i)
         if (flip[component[i]])
           labels[i] = Label(-labels[i]);
+      result.seconds.sign = internal::seconds_since(t);
+      progress.part(Stage::SIGN, 0.9, 0.92).report(1.0);
+
+      // 5. The global stage: the winding number decides the signs of patches.
+      if (policies.global == Global_orientation::WINDING) {
+        progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
+        result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(graph, in.points, in.normals, component,
+                                                                            gr.radius, has_unary, labels);
+        result.seconds.global = result.global.seconds;
+      }
       result.energy_after = energy(graph, weight, label_map);
       for (std::size_t q = 0; q < n; ++q)
         input_labels[order[q]] = labels[q];
-      result.seconds.sign = internal::seconds_since(t);
-      progress.part(Stage::SIGN, 0.9, 1.0).report(1.0);
+      progress.part(Stage::GLOBAL, 0.92, 1.0).report(1.0);
     });
   } catch (const Interrupted&) {
     result.interrupted = true;
@@ -429,7 +459,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
     return result;
   }
 
-  // 5. Write back: only the sign changes.
+  // 6. Write back: only the sign changes.
   const auto t_out = std::chrono::steady_clock::now();
   std::size_t i = 0;
   for (auto it = points.begin(); it != points.end(); ++it, ++i)

@@ -32,6 +32,7 @@
 #include <Normal_orientation/streaming/Scan.h>
 #include <Normal_orientation/streaming/Segment_solve.h>
 #include <Normal_orientation/streaming/Segmenting_sweep.h>
+#include <Normal_orientation/streaming/Global_stage.h>
 #include <Normal_orientation/streaming/Sign_stage.h>
 #include <Normal_orientation/streaming/Streaming_result.h>
 #include <Normal_orientation/streaming/Streaming_settings.h>
@@ -47,6 +48,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -104,8 +106,8 @@ struct Run_hooks
 /// the parts of the whole run that the stages report in
 inline Progress_reporter stage_progress(const Progress_reporter& p, Stage stage)
 {
-  static const double begin[] = {0.0, 0.0, 0.0, 0.08, 0.1, 0.25, 0.7, 0.72, 0.85, 0.9, 0.98};
-  static const double end[] = {0.0, 0.0, 0.08, 0.1, 0.25, 0.7, 0.72, 0.85, 0.9, 0.98, 1.0};
+  static const double begin[] = {0.0, 0.0, 0.0, 0.08, 0.1, 0.25, 0.7, 0.72, 0.85, 0.88, 0.9, 0.98};
+  static const double end[] = {0.0, 0.0, 0.08, 0.1, 0.25, 0.7, 0.72, 0.85, 0.88, 0.9, 0.98, 1.0};
   return p.part(stage, begin[int(stage)], end[int(stage)]);
 }
 
@@ -143,8 +145,8 @@ std::uint64_t scan_and_radius_stages(Source& source, const Streaming_settings& s
 template <typename ConcurrencyTag, typename Kernel, typename Source, typename Sink, typename FlipCriterion,
           typename Solver, typename SignPolicy, typename Unary>
 void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, const FlipCriterion& criterion,
-                const Solver& solver, const SignPolicy& sign_policy, Unary unary, const Run_hooks& hooks,
-                Streaming_result& result)
+                const Solver& solver, const SignPolicy& sign_policy, Global_orientation global, Unary unary,
+                const Run_hooks& hooks, Streaming_result& result)
 {
   using Normal_orientation::internal::seconds_since;
   typedef std::chrono::steady_clock Clock;
@@ -258,7 +260,18 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     solution.number_of_components, swept.segment_size, swept.segment_has_unary, radius, n, stage(Stage::SIGN));
   result.seconds.sign = seconds_since(t);
 
-  // 8. Output, without the small components.
+  // 8. The global stage: the winding number of a subsample decides the signs of segments.
+  if (global == Global_orientation::WINDING) {
+    t = Clock::now();
+    result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component,
+                                                 swept.segment_has_unary, n, stage(Stage::GLOBAL));
+    result.seconds.global = seconds_since(t);
+    if (result.global.patches_flipped > 0) // the energy of the output: exact on the sweep's segments
+      result.energy_after = labels.label_file ? std::numeric_limits<double>::quiet_NaN()
+                                              : segmenter.point_energy(labels.segment_labels);
+  }
+
+  // 9. Output, without the small components.
   std::vector<std::uint64_t> size(solution.number_of_components, 0);
   for (std::size_t s = 0; s < swept.segment_size.size(); ++s)
     size[solution.component[s]] += swept.segment_size[s];
@@ -272,7 +285,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   result.number_of_flipped = output_stage(points, signs, sink, n, stage(Stage::OUTPUT));
   result.seconds.output = seconds_since(t);
 
-  // 9. One file per kept component.
+  // 10. One file per kept component.
   if (component_files.enabled() && ranking.kept > 0) {
     t = Clock::now();
     component_files_stage(points, signs, settings.component_files, settings.temporary_directory, component_files, n,
@@ -312,7 +325,7 @@ Streaming_result orient_stream(Source& source, Sink& sink, const NamedParameters
   try {
     Normal_orientation::internal::run_with_threads(settings.number_of_threads, [&]() {
       run_stages<ConcurrencyTag, Kernel>(source, sink, settings, policies.criterion, policies.solver,
-                                         policies.sign_policy, unary, hooks, result);
+                                         policies.sign_policy, policies.global, unary, hooks, result);
     });
   } catch (const Interrupted&) {
     result.interrupted = true;

@@ -30,6 +30,18 @@ struct Point_labels
   std::vector<Label> segment_labels;                    ///< of the sweep's segments
   std::unique_ptr<Record_file<std::uint32_t>> label_file; ///< (segment << 1) | flipped, per point; or null
   std::vector<Label> label_file_segment_labels;         ///< of the segments of `label_file`
+
+  /// the number of the final segments (those of `label_file` when there is one)
+  std::size_t number_of_segments() const
+  {
+    return label_file ? label_file_segment_labels.size() : segment_labels.size();
+  }
+  /// negates the label of final segment `s`: all its points turn
+  void negate_segment(std::size_t s)
+  {
+    Label& l = label_file ? label_file_segment_labels[s] : segment_labels[s];
+    l = Label(-l);
+  }
 };
 
 /// Reads the record file and the labels, in the sweep order, block by block.
@@ -54,16 +66,21 @@ public:
     m_buffer.clear();
     const std::size_t got = m_records.read(m_buffer, 1 << 15);
     m_point_labels.resize(got);
+    m_segments.resize(got);
     if (m_labels.label_file) {
       m_words.clear();
       if (got > 0 && m_labels.label_file->read(m_words, got) != got)
         throw std::runtime_error("streaming_orient_normals: the label file is shorter than the record file");
-      for (std::size_t q = 0; q < got; ++q)
+      for (std::size_t q = 0; q < got; ++q) {
+        m_segments[q] = m_words[q] >> 1;
         m_point_labels[q] =
           Label(((m_words[q] & 1u) != 0 ? -1 : 1) * m_labels.label_file_segment_labels[m_words[q] >> 1]);
+      }
     } else {
-      for (std::size_t q = 0; q < got; ++q)
+      for (std::size_t q = 0; q < got; ++q) {
+        m_segments[q] = m_buffer[q].segment;
         m_point_labels[q] = Label(m_buffer[q].flip * m_labels.segment_labels[m_buffer[q].segment]);
+      }
     }
     return got;
   }
@@ -71,6 +88,8 @@ public:
   const std::vector<Swept_record>& points() const { return m_buffer; }
   /// their labels
   const std::vector<Label>& labels() const { return m_point_labels; }
+  /// their final segments (see `Point_labels::number_of_segments()`)
+  const std::vector<std::uint32_t>& segments() const { return m_segments; }
 
 private:
   Record_file<Swept_record>& m_records;
@@ -78,6 +97,7 @@ private:
   std::vector<Swept_record> m_buffer;
   std::vector<Label> m_point_labels;
   std::vector<std::uint32_t> m_words;
+  std::vector<std::uint32_t> m_segments;
 };
 
 /// The output record of swept point `s` of label `label` (before the sign

@@ -23,8 +23,8 @@ struct Streaming_seconds
 {
   /// @{
   /// the seconds of the stage of that name (`total`: the whole call)
-  double frame = 0, radius = 0, sort = 0, sweep = 0, solve = 0, refine = 0, sign = 0, output = 0, components = 0,
-         total = 0;
+  double frame = 0, radius = 0, sort = 0, sweep = 0, solve = 0, refine = 0, sign = 0, global = 0, output = 0,
+         components = 0, total = 0;
   /// @}
 };
 
