@@ -147,8 +147,12 @@ run_cell() {
     clear_wrong[$row,$column]=$(json_field clear_wrong "$result")
   fi
   [[ ${status[$row,$column]} == ok ]] || failures=$((failures + 1))
-  echo "  $column: ${status[$row,$column]} ${seconds[$row,$column]} s" \
-       "${wrong[$row,$column]:-} wrong, ${clear_wrong[$row,$column]:-} of ${clear[$row,$column]:-} clear" >&2
+  if [[ ${status[$row,$column]} == ok ]]; then
+    echo "  $column: ${seconds[$row,$column]} s, ${wrong[$row,$column]} wrong," \
+         "${clear_wrong[$row,$column]} of ${clear[$row,$column]} clear" >&2
+  else
+    echo "  $column: ${status[$row,$column]} after ${seconds[$row,$column]} s" >&2
+  fi
   [[ -n "$keep" ]] || rm -f "$output"
 }
 
@@ -224,6 +228,41 @@ else
   done
 fi
 
+# total_row "N NOISE" COMMON: the totals row of a size and noise (of all rows with --clouds);
+# COMMON=1: only over the rows where every column succeeded.
+total_row() {
+  local group=$1 common=$2 column row label="**total**" line times=""
+  [[ $common -eq 0 ]] || label="**total, common rows**"
+  line="| $label | ${group% *} | ${group#* } |"
+  for column in "${columns[@]}"; do
+    local p=0 w=0 c=0 cw=0 s=0 missing=0 mark=""
+    for row in "${rows[@]}"; do
+      [[ -n "$clouds" || "${row_n[$row]} ${row_noise[$row]}" == "$group" ]] || continue
+      if [[ $common -eq 1 ]] && ! row_complete "$row"; then
+        continue
+      elif [[ ${status[$row,$column]:-skipped} == ok ]]; then
+        p=$((p + points[$row,$column])); w=$((w + wrong[$row,$column]))
+        c=$((c + clear[$row,$column])); cw=$((cw + clear_wrong[$row,$column]))
+        s=$(awk -v a="$s" -v b="${seconds[$row,$column]}" 'BEGIN { print a + b }')
+      else
+        missing=$((missing + 1))
+      fi
+    done
+    [[ $missing -eq 0 ]] || mark=" ($missing missing)"
+    line+=" **$(percent $w $p)** ($w)$mark | **$(percent $cw $c)** ($cw) |"
+    times+=" $(awk -v a="$s" 'BEGIN { printf "%.2f", a }') |"
+  done
+  echo "$line$times"
+}
+
+# row_complete ROW: true when every column of ROW succeeded.
+row_complete() {
+  local column
+  for column in "${columns[@]}"; do
+    [[ ${status[$1,$column]:-skipped} == ok ]] || return 1
+  done
+}
+
 # The Markdown report.
 percent() { awk -v a="$1" -v b="$2" 'BEGIN { if (b > 0) printf "%.2f", 100 * a / b; else printf "-" }'; }
 report() {
@@ -266,7 +305,8 @@ report() {
     done
     echo "$line"
   done
-  # Totals per size and noise: sums of counts and times over the rows where the column succeeded.
+  # Totals per size and noise; when a column has failed or skipped rows there, a second row
+  # sums only the rows where every column succeeded, so that the columns compare.
   local groups=()
   declare -A seen=()
   for row in "${rows[@]}"; do
@@ -275,28 +315,15 @@ report() {
     [[ -n "${seen[$group]+x}" ]] || { seen[$group]=1; groups+=("$group"); }
   done
   for group in "${groups[@]}"; do
-    local line="| **total** | ${group% *} | ${group#* } |" times=""
-    for column in "${columns[@]}"; do
-      local p=0 w=0 c=0 cw=0 s=0 missing=0
-      for row in "${rows[@]}"; do
-        [[ -n "$clouds" || "${row_n[$row]} ${row_noise[$row]}" == "$group" ]] || continue
-        if [[ ${status[$row,$column]:-skipped} == ok ]]; then
-          p=$((p + points[$row,$column])); w=$((w + wrong[$row,$column]))
-          c=$((c + clear[$row,$column])); cw=$((cw + clear_wrong[$row,$column]))
-          s=$(awk -v a="$s" -v b="${seconds[$row,$column]}" 'BEGIN { print a + b }')
-        else
-          missing=$((missing + 1))
-        fi
-      done
-      local mark=""
-      [[ $missing -eq 0 ]] || mark=" ($missing missing)"
-      line+=" **$(percent $w $p)** ($w)$mark | **$(percent $cw $c)** ($cw) |"
-      times+=" $(awk -v a="$s" 'BEGIN { printf "%.2f", a }') |"
-    done
-    echo "$line$times"
+    local first
+    first=$(total_row "$group" 0)
+    echo "$first"
+    [[ $first != *missing* ]] || total_row "$group" 1
   done
   echo
-  echo "Totals: wrong normals summed over the rows of a size and noise (in parentheses), in % of the summed points; times summed."
+  echo "Totals: wrong normals summed over the rows of a size and noise (in parentheses), in % of the"
+  echo "summed points, and summed times; \"(k missing)\": k rows of the column failed, timed out or were"
+  echo "skipped; \"total, common rows\": only the rows where every column succeeded."
 }
 
 if [[ -n "$out" ]]; then
