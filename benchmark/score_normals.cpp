@@ -1,0 +1,196 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+//
+// score_normals ORIENTED.xyz TRUTH.gt.xyz [--json]
+//
+// Scores an oriented cloud against the truth written by make_cloud: both files hold the same
+// points in the same order (x y z nx ny nz). A normal is wrong when its dot product with the
+// true normal is <= 0. The score is given over all normals and over the "clear" normals, whose
+// line is within 60 degrees of the true normal's line (|cos| >= 0.5): only there does the sign
+// of a normal mean something. Zero and non-finite normals are wrong, in both counts.
+#include "Xyz_io.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace {
+
+using Normal_orientation::benchmark::Xyz_row;
+
+/// Prints the usage message to `out`.
+void print_usage(std::FILE* out)
+{
+  std::fprintf(out,
+               "usage: score_normals ORIENTED.xyz TRUTH.gt.xyz [--json]\n"
+               "  Both files: x y z nx ny nz per line, the same points in the same order (the\n"
+               "  truth as make_cloud writes it). Prints the points, the wrong normals (dot with\n"
+               "  the true normal <= 0) over all normals, and over the clear normals, whose line\n"
+               "  is within 60 degrees of the true normal (|cos| >= 0.5). Zero and non-finite\n"
+               "  normals are wrong and count as clear. --json: one JSON line on stdout.\n"
+               "  Exit status: 0 scored, 1 unreadable or mismatched files, 2 bad usage.\n");
+}
+
+/// The counts of one scoring.
+struct Score
+{
+  std::size_t points = 0;      ///< normals scored
+  std::size_t wrong = 0;       ///< dot with the truth <= 0, or invalid
+  std::size_t clear = 0;       ///< |cos| >= 0.5, or invalid
+  std::size_t clear_wrong = 0; ///< wrong among the clear ones
+  std::size_t invalid = 0;     ///< zero or non-finite normals
+};
+
+/// Returns `100 * part / whole`, or 0 when `whole` is 0.
+double percent(std::size_t part, std::size_t whole)
+{
+  return whole == 0 ? 0.0 : 100.0 * double(part) / double(whole);
+}
+
+/// Returns the bounding-box diagonal of the points of `rows`.
+double bbox_diagonal(const std::vector<Xyz_row>& rows)
+{
+  if(rows.empty())
+    return 0.0;
+  double lo[3] = {rows[0][0], rows[0][1], rows[0][2]};
+  double hi[3] = {lo[0], lo[1], lo[2]};
+  for(const Xyz_row& r : rows)
+    for(int c = 0; c < 3; ++c)
+    {
+      lo[c] = std::fmin(lo[c], r[c]);
+      hi[c] = std::fmax(hi[c], r[c]);
+    }
+  return std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                   (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+/**
+ * Checks that `oriented` has the points of `truth` in the same order, each within
+ * `1e-5 x` the truth's bounding-box diagonal (both files may be written with 9 digits).
+ * Returns an empty string on success, else the reason.
+ */
+std::string check_same_points(const std::vector<Xyz_row>& oriented, const std::vector<Xyz_row>& truth)
+{
+  if(oriented.size() != truth.size())
+    return "the oriented cloud has " + std::to_string(oriented.size()) + " points, the truth " +
+           std::to_string(truth.size()) + ": not the same cloud";
+  const double tolerance = 1e-5 * bbox_diagonal(truth);
+  for(std::size_t i = 0; i < truth.size(); ++i)
+  {
+    const double dx = oriented[i][0] - truth[i][0];
+    const double dy = oriented[i][1] - truth[i][1];
+    const double dz = oriented[i][2] - truth[i][2];
+    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
+    if(!(d <= tolerance))
+    {
+      char message[256];
+      std::snprintf(message, sizeof message,
+                    "point %zu (counted from 0) is %.3g away from the truth's (tolerance %.3g): "
+                    "the files do not hold the same points in the same order",
+                    i, d, tolerance);
+      return message;
+    }
+  }
+  return std::string();
+}
+
+/// Scores `oriented` against `truth` (same size, checked before).
+Score score(const std::vector<Xyz_row>& oriented, const std::vector<Xyz_row>& truth)
+{
+  Score s;
+  s.points = truth.size();
+  for(std::size_t i = 0; i < truth.size(); ++i)
+  {
+    const double* n = &oriented[i][3];
+    const double* g = &truth[i][3];
+    const double dot = n[0] * g[0] + n[1] * g[1] + n[2] * g[2];
+    const double lengths = std::sqrt((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]));
+    const bool valid = std::isfinite(dot) && std::isfinite(lengths) && lengths > 0.0;
+    if(!valid)
+    {
+      ++s.invalid;
+      ++s.wrong;
+      ++s.clear;
+      ++s.clear_wrong;
+      continue;
+    }
+    const bool wrong = !(dot > 0.0);
+    const bool clear = std::fabs(dot) >= 0.5 * lengths;
+    s.wrong += wrong ? 1 : 0;
+    s.clear += clear ? 1 : 0;
+    s.clear_wrong += (clear && wrong) ? 1 : 0;
+  }
+  return s;
+}
+
+} // namespace
+
+/// Entry point: see print_usage().
+int main(int argc, char** argv)
+{
+  bool json = false;
+  std::vector<std::string> positional;
+  for(int i = 1; i < argc; ++i)
+  {
+    const std::string arg = argv[i];
+    if(arg == "-h" || arg == "--help")
+    {
+      print_usage(stdout);
+      return EXIT_SUCCESS;
+    }
+    else if(arg == "--json")
+      json = true;
+    else if(!arg.empty() && arg[0] == '-' && arg != "-")
+    {
+      std::fprintf(stderr, "score_normals: unknown option '%s'\n", arg.c_str());
+      print_usage(stderr);
+      return 2;
+    }
+    else
+      positional.push_back(arg);
+  }
+  if(positional.size() != 2)
+  {
+    print_usage(stderr);
+    return 2;
+  }
+
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<Xyz_row> oriented, truth;
+  std::string error;
+  if(!Normal_orientation::benchmark::read_xyz_rows(positional[0], oriented, error) ||
+     !Normal_orientation::benchmark::read_xyz_rows(positional[1], truth, error))
+  {
+    std::fprintf(stderr, "score_normals: %s\n", error.c_str());
+    return EXIT_FAILURE;
+  }
+  if(truth.empty())
+  {
+    std::fprintf(stderr, "score_normals: '%s' holds no point\n", positional[1].c_str());
+    return EXIT_FAILURE;
+  }
+  error = check_same_points(oriented, truth);
+  if(!error.empty())
+  {
+    std::fprintf(stderr, "score_normals: '%s' against '%s': %s\n", positional[0].c_str(), positional[1].c_str(),
+                 error.c_str());
+    return EXIT_FAILURE;
+  }
+  const Score s = score(oriented, truth);
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+
+  if(json)
+    std::printf("{\"points\":%zu,\"wrong\":%zu,\"wrong_percent\":%.4f,\"clear\":%zu,\"clear_wrong\":%zu,"
+                "\"clear_wrong_percent\":%.4f,\"invalid\":%zu,\"seconds\":%.3f}\n",
+                s.points, s.wrong, percent(s.wrong, s.points), s.clear, s.clear_wrong,
+                percent(s.clear_wrong, s.clear), s.invalid, seconds);
+  else
+    std::printf("points %zu wrong %zu (%.2f%%) clear %zu (%.2f%%) clear_wrong %zu (%.2f%%) invalid %zu\n", s.points,
+                s.wrong, percent(s.wrong, s.points), s.clear, percent(s.clear, s.points), s.clear_wrong,
+                percent(s.clear_wrong, s.clear), s.invalid);
+  return EXIT_SUCCESS;
+}
