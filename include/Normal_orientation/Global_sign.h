@@ -51,12 +51,10 @@ struct Global_sign_options
   /// samples agreeing with a closed surface hold at least this fraction of
   /// its area
   double closed_fraction = 0.5;
-  /// a patch is a candidate when negating it would lower the energy by at
-  /// least this much per unit of its area, to first order
-  double candidate_threshold = 0.1;
   /// a patch is negated only when that lowers the energy by at least this
-  /// much per unit of its area (exactly, with the field as it is): smaller
-  /// changes are within what noise and sampling make of w
+  /// much per unit of its area: smaller changes are within what noise and
+  /// sampling make of w.  (The first-order decrease bounds the exact one,
+  /// so only the patches whose first-order decrease reaches it are tried.)
   double minimum_decrease = 0.3;
   /// the most rounds of patch flips
   unsigned int maximum_rounds = 32;
@@ -190,8 +188,11 @@ double negation_change(const Field& field, const std::vector<Point>& points, con
   patch_field.set_opening_ratio(field.opening_ratio());
   patch_field.set_smoothing_factor(field.smoothing_factor());
   patch_field.template build<ConcurrencyTag>(p, m, a);
-  std::vector<double> c;
-  patch_field.template evaluate<ConcurrencyTag>(points, c);
+  std::vector<double> c(points.size()); // (the samples are in a spatial order already: no sort)
+  parallel_chunks<ConcurrencyTag>(points.size(), [&](std::size_t b, std::size_t e) {
+    for (std::size_t j = b; j < e; ++j)
+      c[j] = patch_field.value(points[j]);
+  }, 256);
   double d = 0.0;
   own.resize(c.size());
   for (std::size_t j = 0; j < c.size(); ++j) {
@@ -284,7 +285,7 @@ bool Winding_patch_signs<Kernel>::round(const std::vector<std::vector<std::uint3
   const std::vector<double> gain = internal::patch_gains<ConcurrencyTag>(m_field, m_areas, m_w, members);
   std::vector<std::uint32_t> candidates;
   for (std::uint32_t P = 0; P < np; ++P)
-    if ((fixed.empty() || !fixed[P]) && !members[P].empty() && gain[P] > options.candidate_threshold)
+    if ((fixed.empty() || !fixed[P]) && !members[P].empty() && gain[P] >= options.minimum_decrease)
       candidates.push_back(P);
   std::stable_sort(candidates.begin(), candidates.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return gain[a] > gain[b]; });
