@@ -35,10 +35,16 @@ enum class Global_orientation
 };
 
 /// \ingroup PkgNormalOrientationGlobal
-/// The most points the drivers build the global stage's field on: every
-/// ceil(n / `global_samples`)-th point of the spatially sorted cloud (in
-/// core) or of the sweep order (streamed).
-constexpr std::size_t global_samples = std::size_t(1) << 14;
+/// The number of samples the drivers build the global stage's field on, for
+/// a cloud of n points: n / 16, at least 2^14 (or n) and at most 2^16.  They
+/// take every ceil(n / m)-th point of the spatially sorted cloud (in core)
+/// or of the sweep order (streamed).  A subsample much coarser than the
+/// cloud blurs walls thinner than its spacing.
+inline std::uint64_t global_samples(std::uint64_t n)
+{
+  return std::min<std::uint64_t>(n, std::max<std::uint64_t>(std::uint64_t(1) << 14,
+                                                            std::min<std::uint64_t>(n / 16, std::uint64_t(1) << 16)));
+}
 
 /// \ingroup PkgNormalOrientationGlobal
 /// The settings of `decide_patch_signs()`.
@@ -57,7 +63,7 @@ struct Global_sign_options
   /// so only the patches whose first-order decrease reaches it are tried.)
   double minimum_decrease = 0.3;
   /// the most rounds of patch flips
-  unsigned int maximum_rounds = 32;
+  unsigned int maximum_rounds = 8;
   /// the patches whose exact change of energy is computed per round (those
   /// with the largest first-order decrease)
   std::size_t candidates_per_round = 32;

@@ -145,7 +145,8 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = points.size();
   // Every stride-th point of the Morton order with a normal: an even subsample.
-  const std::size_t stride = std::max<std::size_t>(1, (n + global_samples - 1) / global_samples);
+  const std::size_t m = std::max<std::size_t>(1, std::size_t(global_samples(n)));
+  const std::size_t stride = std::max<std::size_t>(1, (n + m - 1) / m);
   std::vector<char> is_sample(n, 0);
   std::vector<std::uint32_t> sample_index;
   for (std::size_t i = 0; i < n; i += stride)
