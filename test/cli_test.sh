@@ -363,6 +363,21 @@ check "--keep-order: the same normals as the sweep order" awk '
 expect_exit 2 "--keep-order into another format" "$prog" --quiet --stream --keep-order "$dir/sphere.xyz" "$dir/kept.ply"
 check "no output for --keep-order into another format" test ! -e "$dir/kept.ply"
 
+# the global sign stage: on by default, reported in the JSON; --global none turns it off
+expect_exit 0 "default: global stage in the json" "$prog" --quiet --json "$dir/sphere.xyz" "$dir/g_default.xyz"
+check "json has a global object with a closedness" grep -q '"global": {"stage": "winding", "closedness": ' "$dir/out.txt"
+expect_exit 0 "--global none" "$prog" --quiet --json --global none "$dir/sphere.xyz" "$dir/g_none.xyz"
+check "json global is null with --global none" grep -q '"global": null' "$dir/out.txt"
+expect_exit 0 "--viewpoint: no global stage by default" "$prog" --quiet --json --viewpoint 0,0,0 "$dir/sphere.xyz" \
+  "$dir/g_vp.xyz"
+check "json global is null with --viewpoint" grep -q '"global": null' "$dir/out.txt"
+check "with --viewpoint 0,0,0 every normal points inward" awk '{ if ($1*$4 + $2*$5 + $3*$6 >= 0) bad++ } END { exit bad > 0 }' \
+  "$dir/g_vp.xyz"
+expect_exit 0 "--stream: global stage in the json" "$prog" --quiet --json --stream "$dir/sphere.xyz" "$dir/g_stream.xyz"
+check "streamed json has a global object" grep -q '"global": {"stage": "winding"' "$dir/out.txt"
+expect_exit 0 "--stream --global none" "$prog" --quiet --json --stream --global none "$dir/sphere.xyz" "$dir/g_sn.xyz"
+check "streamed json global is null with --global none" grep -q '"global": null' "$dir/out.txt"
+
 # bad options: exit 2, one line on stderr, no output (the options of --stream
 # need it)
 for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--orders 0" "--threads -1" "--threads x" \
@@ -371,7 +386,7 @@ for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--or
     "--stream --min-component-size -1" "--stream --min-component-size x" "--write-segments" \
     "--stream --write-segments" "--batch-size 10" "--stream --batch-size 0" "--stream --batch-size x" \
     "--keep-order" "--stream --keep-order --ascii" "--stream --keep-order --write-segments" "--refine 1" \
-    "--stream --refine 65" "--stream --refine x"; do
+    "--stream --refine 65" "--stream --refine x" "--global foo" "--global" "--stream --global x"; do
   # shellcheck disable=SC2086
   expect_exit 2 "bad option $args" "$prog" $args "$dir/sphere.xyz" "$dir/bad_opt.xyz"
   check "one-line error for $args" test "$(wc -l < "$dir/err.txt")" -eq 1
