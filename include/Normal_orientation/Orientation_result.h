@@ -22,7 +22,7 @@ struct Global_sign_summary
   std::size_t number_of_samples = 0;   ///< points the field was built on (a subsample of large clouds)
   std::size_t number_of_patches = 0;   ///< patches whose signs were decided
   std::size_t patches_flipped = 0;     ///< patches the stage negated
-  std::uint64_t points_flipped = 0;    ///< points of those patches
+  std::uint64_t points_flipped = 0;    ///< points of those patches (in core; 0 streamed)
   std::size_t closed_components = 0;   ///< components found closed: the stage's signs were kept there
   std::size_t open_components = 0;     ///< components found open: the stage left them as they were
   unsigned int rounds = 0;             ///< rounds of patch flips
@@ -49,7 +49,7 @@ struct Orientation_summary
   bool radius_estimated = false;           ///< true when r was estimated from the data
   double energy_before = 0.0;              ///< energy (eq. 3) of the point graph with the input orientation
   /// energy of the point graph with the output orientation (streamed: NaN,
-  /// not measured, when the global stage negated segments of a refined labelling)
+  /// not measured, when the global stage negated points)
   double energy_after = 0.0;
   std::size_t number_of_segments = 0;      ///< vertices of the segment graph the solver worked on (0: none)
   std::uint64_t number_of_unary_terms = 0; ///< points with a constraint or a non-zero prior

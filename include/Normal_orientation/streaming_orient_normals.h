@@ -264,11 +264,10 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   if (global == Global_orientation::WINDING) {
     t = Clock::now();
     result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component,
-                                                 swept.segment_has_unary, n, stage(Stage::GLOBAL));
+                                                 swept.segment_has_unary, radius, n, stage(Stage::GLOBAL));
     result.seconds.global = seconds_since(t);
-    if (result.global.patches_flipped > 0) // the energy of the output: exact on the sweep's segments
-      result.energy_after = labels.label_file ? std::numeric_limits<double>::quiet_NaN()
-                                              : segmenter.point_energy(labels.segment_labels);
+    if (labels.point_flip) // (point by point: the energy of the output is not measured)
+      result.energy_after = std::numeric_limits<double>::quiet_NaN();
   }
 
   // 9. Output, without the small components.

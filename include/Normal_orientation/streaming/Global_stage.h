@@ -5,23 +5,26 @@
 
 /// \file Global_stage.h
 /// The global sign stage of the streaming driver: the winding number of a
-/// bounded subsample of the labelled records decides the signs of the final
-/// segments (`decide_patch_signs()`, as in core), and the segments without
-/// a sample follow the samples near their points.
+/// bounded subsample of the labelled records decides the signs of patches
+/// (the final segments, cut by cells, as the in-core patches are), and every
+/// point follows the samples near it.
 
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Winding_number_field.h>
+#include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/streaming/Labelled_records.h>
 #include <Normal_orientation/streaming/Segmenting_sweep.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <numeric>
 #include <unordered_map>
 #include <vector>
@@ -99,102 +102,127 @@ private:
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> m_cells;
 };
 
-/// The global stage on the labelled records: negates, in `labels`, the
-/// final segments whose patch the field negates.  `component` and
-/// `segment_has_unary` are per sweep segment; `flip_component` is the sign
-/// stage's decision.  Memory: the subsample, and O(segments).
+/// The decision of the global stage for every point of the stream: a
+/// point takes the decision of a sample of its grid cell in its component
+/// whose oriented normal agrees with its own (within 60 degrees), else the
+/// majority of the samples of its final segment.
+struct Global_point_flips
+{
+  std::shared_ptr<const Sample_grid> grid;
+  std::vector<std::array<double, 3>> normal;           ///< the samples' oriented normals
+  std::vector<std::uint32_t> component;                ///< the samples' components
+  std::vector<char> flip;                              ///< per sample
+  std::unordered_map<std::uint32_t, char> segment_flip; ///< per final segment with samples: the majority
+  const std::vector<std::uint32_t>* segment_component = nullptr; ///< per sweep segment
+  const std::vector<char>* flip_component = nullptr;
+
+  bool operator()(const Swept_record& s, std::uint32_t segment, Label label) const
+  {
+    const std::uint32_t c = (*segment_component)[s.segment];
+    const std::array<double, 3> u = unit_normal(s.record);
+    const double sign = double(label) * ((*flip_component)[c] ? -1.0 : 1.0);
+    if (const auto* cell = grid->find(s.record.position[0], s.record.position[1], s.record.position[2]))
+      for (std::uint32_t j : *cell)
+        if (component[j] == c && sign * (u[0] * normal[j][0] + u[1] * normal[j][1] + u[2] * normal[j][2]) > 0.5)
+          return flip[j] != 0;
+    const auto it = segment_flip.find(segment);
+    return it != segment_flip.end() && it->second != 0;
+  }
+};
+
+/// The patches of one level: the final segment of each sample, cut by
+/// cells of side `cell` (0: not cut), numbered densely in sample order.
+template <typename Point>
+std::vector<std::uint32_t> segment_patches(const std::vector<Point>& points, const std::vector<std::uint32_t>& segment,
+                                           double cell, std::vector<std::uint32_t>& first_sample)
+{
+  std::unordered_map<std::uint64_t, std::uint32_t> id;
+  std::vector<std::uint32_t> patch(points.size());
+  first_sample.clear();
+  for (std::size_t j = 0; j < points.size(); ++j) {
+    std::uint64_t key = segment[j];
+    if (cell > 0.0)
+      for (int d = 0; d < 3; ++d)
+        key = (key << 10) ^ (std::uint64_t(std::int64_t(std::floor(points[j][d] / cell))) & 0x3FF);
+    const auto ins = id.emplace(key, std::uint32_t(first_sample.size()));
+    if (ins.second)
+      first_sample.push_back(std::uint32_t(j));
+    patch[j] = ins.first->second;
+  }
+  return patch;
+}
+
+/// The global stage on the labelled records: the same search as in core
+/// (`Winding_patch_signs`) on a subsample, over three levels of patches
+/// (the final segments, then the segments cut by cells of 4 and 1.5 radii);
+/// the points then follow the samples (`Global_point_flips`, installed in
+/// `labels`).  `component` and `segment_has_unary` are per sweep segment;
+/// `flip_component` is the sign stage's decision.  Memory: the subsample,
+/// and O(segments).
 template <typename ConcurrencyTag>
 Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
                                  const std::vector<std::uint32_t>& component, const std::vector<char>& flip_component,
-                                 const std::vector<char>& segment_has_unary, std::uint64_t n,
+                                 const std::vector<char>& segment_has_unary, double radius, std::uint64_t n,
                                  const Progress_reporter& progress)
 {
   typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
   const auto t0 = std::chrono::steady_clock::now();
-  progress.report(0, 3);
+  progress.report(0, 4);
   const std::uint64_t m = std::max<std::uint64_t>(1, global_samples(n));
   const std::uint64_t stride = std::max<std::uint64_t>(1, (n + m - 1) / m);
   Global_samples<Kernel> samples = collect_global_samples<Kernel>(points, component, flip_component, stride);
-  progress.report(1, 3);
+  progress.report(1, 4);
   Global_sign_summary report;
-  if (samples.points.empty()) {
-    progress.report(3, 3);
+  const std::size_t ns = samples.points.size();
+  if (ns == 0) {
+    progress.report(4, 4);
     return report;
-  }
-
-  // Patches: the final segments that hold a sample, numbered densely.
-  std::unordered_map<std::uint32_t, std::uint32_t> patch_of_segment;
-  std::vector<std::uint32_t> patch(samples.points.size()), patch_component, patch_segment;
-  for (std::size_t j = 0; j < samples.points.size(); ++j) {
-    const auto ins = patch_of_segment.emplace(samples.segment[j], std::uint32_t(patch_component.size()));
-    if (ins.second) {
-      patch_component.push_back(samples.component[j]);
-      patch_segment.push_back(samples.segment[j]);
-    }
-    patch[j] = ins.first->second;
-  }
-  std::vector<char> fixed;
-  if (!labels.label_file) { // (with unary terms there is no refinement: the final segments are the sweep's)
-    fixed.assign(patch_segment.size(), 0);
-    for (std::size_t P = 0; P < patch_segment.size(); ++P)
-      fixed[P] = segment_has_unary[patch_segment[P]];
   }
   std::vector<double> areas = estimate_point_areas<ConcurrencyTag>(samples.points, samples.normals);
   Normal_orientation::internal::cap_areas(areas);
-  std::vector<char> flip;
-  report = decide_patch_signs<ConcurrencyTag>(samples.points, samples.normals, areas, patch, patch_component, fixed,
-                                              flip, Global_sign_options());
-  progress.report(2, 3);
-
-  // The segments without a sample follow the samples in the cells of their
-  // points whose oriented normal agrees with theirs, by majority.
-  std::vector<char> segment_flip(labels.number_of_segments(), 0);
-  for (std::size_t P = 0; P < flip.size(); ++P)
-    segment_flip[patch_segment[P]] = flip[P];
-  if (report.patches_flipped > 0) {
+  Winding_patch_signs<Kernel> search;
+  search.template build<ConcurrencyTag>(samples.points, samples.normals, areas);
+  std::vector<char> sample_flip(ns, 0);
+  for (double cell_radii : Normal_orientation::internal::patch_cell_radii) {
+    std::vector<std::uint32_t> first;
+    const std::vector<std::uint32_t> patch = segment_patches(samples.points, samples.segment, cell_radii * radius, first);
+    std::vector<std::uint32_t> patch_component(first.size());
+    std::vector<char> fixed(first.size(), 0);
+    for (std::size_t P = 0; P < first.size(); ++P)
+      patch_component[P] = samples.component[first[P]];
+    if (!labels.label_file) // (with unary terms there is no refinement: the final segments are the sweep's)
+      for (std::size_t j = 0; j < ns; ++j)
+        fixed[patch[j]] |= segment_has_unary[samples.segment[j]];
+    std::vector<char> flip;
+    const Global_sign_summary level = search.template decide<ConcurrencyTag>(patch, patch_component, fixed, flip);
+    for (std::size_t j = 0; j < ns; ++j)
+      sample_flip[j] ^= flip[patch[j]];
+    Normal_orientation::internal::add_level(report, level);
+  }
+  progress.report(3, 4);
+  report.points_flipped = 0; // (counted in core only)
+  if (std::find(sample_flip.begin(), sample_flip.end(), 1) != sample_flip.end()) {
+    auto flips = std::make_shared<Global_point_flips>();
     const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
-    const Sample_grid grid(samples.points, 2.0 * std::sqrt(area / double(samples.points.size())));
-    std::unordered_map<std::uint32_t, std::int64_t> votes;   // segment -> (flip votes - keep votes)
-    std::unordered_map<std::uint32_t, std::uint64_t> sizes; // points of the segments that may flip
-    points.rewind();
-    while (points.read() > 0) {
-      const std::vector<Swept_record>& buffer = points.points();
-      for (std::size_t q = 0; q < buffer.size(); ++q) {
-        const std::uint32_t seg = points.segments()[q];
-        const auto sampled = patch_of_segment.find(seg);
-        if (sampled != patch_of_segment.end()) {
-          if (flip[sampled->second])
-            ++sizes[seg];
-          continue;
-        }
-        ++sizes[seg];
-        const Swept_record& s = buffer[q];
-        const auto* cell = grid.find(s.record.position[0], s.record.position[1], s.record.position[2]);
-        if (cell == nullptr)
-          continue;
-        const std::array<double, 3> u = unit_normal(s.record);
-        const double sign = double(points.labels()[q]) * (flip_component[component[s.segment]] ? -1.0 : 1.0);
-        for (std::uint32_t j : *cell) {
-          const auto& m = samples.normals[j];
-          if (sign * (u[0] * m.x() + u[1] * m.y() + u[2] * m.z()) > 0.5) {
-            votes[seg] += flip[patch[j]] ? 1 : -1;
-            break;
-          }
-        }
-      }
+    flips->grid = std::make_shared<const Sample_grid>(samples.points, 2.0 * std::sqrt(area / double(ns)));
+    std::unordered_map<std::uint32_t, std::int64_t> votes;
+    for (std::size_t j = 0; j < ns; ++j) {
+      const auto& v = samples.normals[j];
+      flips->normal.push_back({{v.x(), v.y(), v.z()}});
+      votes[samples.segment[j]] += sample_flip[j] ? 1 : -1;
     }
     for (const auto& v : votes)
-      if (v.second > 0)
-        segment_flip[v.first] = 1;
-    for (const auto& z : sizes)
-      if (segment_flip[z.first])
-        report.points_flipped += z.second;
+      flips->segment_flip.emplace(v.first, char(v.second > 0));
+    flips->component = std::move(samples.component);
+    flips->flip = std::move(sample_flip);
+    flips->segment_component = &component;
+    flips->flip_component = &flip_component;
+    labels.point_flip = [flips](const Swept_record& s, std::uint32_t segment, Label label) {
+      return (*flips)(s, segment, label);
+    };
   }
-  for (std::size_t s = 0; s < segment_flip.size(); ++s)
-    if (segment_flip[s])
-      labels.negate_segment(s);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  progress.report(3, 3);
+  progress.report(4, 4);
   return report;
 }
 

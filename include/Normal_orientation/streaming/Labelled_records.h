@@ -14,6 +14,7 @@
 #include <Normal_orientation/streaming/Segmenting_sweep.h>
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <vector>
@@ -30,18 +31,10 @@ struct Point_labels
   std::vector<Label> segment_labels;                    ///< of the sweep's segments
   std::unique_ptr<Record_file<std::uint32_t>> label_file; ///< (segment << 1) | flipped, per point; or null
   std::vector<Label> label_file_segment_labels;         ///< of the segments of `label_file`
+  /// when set, the points for which it returns true (given the point, its
+  /// final segment and its label) are negated too: the global stage's decision
+  std::function<bool(const Swept_record&, std::uint32_t, Label)> point_flip;
 
-  /// the number of the final segments (those of `label_file` when there is one)
-  std::size_t number_of_segments() const
-  {
-    return label_file ? label_file_segment_labels.size() : segment_labels.size();
-  }
-  /// negates the label of final segment `s`: all its points turn
-  void negate_segment(std::size_t s)
-  {
-    Label& l = label_file ? label_file_segment_labels[s] : segment_labels[s];
-    l = Label(-l);
-  }
 };
 
 /// Reads the record file and the labels, in the sweep order, block by block.
@@ -82,13 +75,17 @@ public:
         m_point_labels[q] = Label(m_buffer[q].flip * m_labels.segment_labels[m_buffer[q].segment]);
       }
     }
+    if (m_labels.point_flip)
+      for (std::size_t q = 0; q < got; ++q)
+        if (m_labels.point_flip(m_buffer[q], m_segments[q], m_point_labels[q]))
+          m_point_labels[q] = Label(-m_point_labels[q]);
     return got;
   }
   /// the points of the last `read()`
   const std::vector<Swept_record>& points() const { return m_buffer; }
   /// their labels
   const std::vector<Label>& labels() const { return m_point_labels; }
-  /// their final segments (see `Point_labels::number_of_segments()`)
+  /// their final segments (those of the label file when there is one)
   const std::vector<std::uint32_t>& segments() const { return m_segments; }
 
 private:
