@@ -251,6 +251,7 @@ public:
     m_areas = areas;
     m_field.template build<ConcurrencyTag>(points, normals, areas);
     m_energy = internal::winding_energy<ConcurrencyTag>(m_field, m_points, m_areas, m_w);
+    m_w_evaluated = true;
   }
 
   /// the number of samples
@@ -279,6 +280,7 @@ private:
   std::vector<Point_3> m_points;
   std::vector<double> m_areas, m_w;
   double m_energy = 0.0;
+  bool m_w_evaluated = false; ///< m_w is the treecode's, not predicted by the rounds
 };
 
 template <typename Kernel>
@@ -342,6 +344,7 @@ bool Winding_patch_signs<Kernel>::round(const std::vector<std::vector<std::uint3
     m_w[j] = residual[j] + 0.5;
     m_energy += m_areas[j] * residual[j] * residual[j];
   }
+  m_w_evaluated = false;
   return true;
 }
 
@@ -381,6 +384,7 @@ void Winding_patch_signs<Kernel>::keep_closed(const std::vector<std::uint32_t>& 
   if (!undo.empty()) { // open components keep their input signs
     internal::negate_patches(m_field, undo, members, flip);
     m_energy = internal::winding_energy<CGAL::Parallel_if_available_tag>(m_field, m_points, m_areas, m_w);
+    m_w_evaluated = true;
   }
   for (std::size_t P = 0; P < np; ++P)
     report.patches_flipped += flip[P] ? 1 : 0;
@@ -406,7 +410,11 @@ Global_sign_summary Winding_patch_signs<Kernel>::decide(const std::vector<std::u
   report.number_of_patches = np;
   flip.assign(np, 0);
   const std::vector<std::vector<std::uint32_t>> members = internal::patch_members(patch, np);
-  report.energy_before = m_energy = internal::winding_energy<ConcurrencyTag>(m_field, m_points, m_areas, m_w);
+  if (!m_w_evaluated) { // the rounds of the last call predicted w: evaluate it anew
+    m_energy = internal::winding_energy<ConcurrencyTag>(m_field, m_points, m_areas, m_w);
+    m_w_evaluated = true;
+  }
+  report.energy_before = m_energy;
   while (report.rounds < options.maximum_rounds && round<ConcurrencyTag>(members, fixed, flip, options))
     ++report.rounds;
   keep_closed(patch, component, members, flip, options, report);

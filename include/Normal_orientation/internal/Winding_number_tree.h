@@ -214,27 +214,12 @@ public:
     w = 0.0;
     if (Gradient)
       g[0] = g[1] = g[2] = 0.0;
-    if (nodes_.empty())
-      return;
-    const std::size_t first_leaf = (std::size_t(1) << depth_) - 1;
-    std::size_t stack[128];
-    std::size_t top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-      const std::size_t i = stack[--top];
-      const Winding_node& node = nodes_[i];
-      const double R[3] = {node.center[0] - q[0], node.center[1] - q[1], node.center[2] - q[2]};
-      const double dist2 = R[0] * R[0] + R[1] * R[1] + R[2] * R[2];
-      if (dist2 > beta2 * node.radius * node.radius) {
-        Winding_kernel::add_node<Gradient>(node, R, f2 * node.mean_area, w, g);
-      } else if (i >= first_leaf) {
-        const std::size_t j = i - first_leaf;
-        add_samples<Gradient>(q, f2, range_begin(depth_, j), range_begin(depth_, j + 1), w, g);
-      } else { // the far child first, so that the near one is summed first
-        stack[top++] = 2 * i + 2;
-        stack[top++] = 2 * i + 1;
-      }
-    }
+    traverse(
+      q, beta2,
+      [&](std::size_t i, const double R[3], double) {
+        Winding_kernel::add_node<Gradient>(nodes_[i], R, f2 * nodes_[i].mean_area, w, g);
+      },
+      [&](std::size_t b, std::size_t e) { add_samples<Gradient>(q, f2, b, e, w, g); });
   }
 
   /// w(q) (and grad w(q)) by the direct sum over all samples, without the
@@ -289,7 +274,42 @@ public:
   void charge_field(const double x[3], double beta2, double e2, double F[3]) const
   {
     F[0] = F[1] = F[2] = 0.0;
-    if (nodes_.empty() || charges_.size() != nodes_.size())
+    if (charges_.size() != nodes_.size())
+      return;
+    traverse(
+      x, beta2,
+      [&](std::size_t i, const double R[3], double dist2) {
+        // F = -Q R / d^3 - D / d^3 + 3 (D . R) R / d^5, with R = c - x
+        const Charge_node& c = charges_[i];
+        const double d2 = dist2 + e2;
+        const double inv_d3 = 1.0 / (d2 * std::sqrt(d2));
+        const double DR = c.moment[0] * R[0] + c.moment[1] * R[1] + c.moment[2] * R[2];
+        for (int k = 0; k < 3; ++k)
+          F[k] += (-c.charge * R[k] - c.moment[k] + 3.0 * DR * R[k] / d2) * inv_d3;
+      },
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t t = b; t < e; ++t) {
+          const Winding_sample& s = samples_[t];
+          const double r[3] = {x[0] - s.p[0], x[1] - s.p[1], x[2] - s.p[2]};
+          const double d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + e2;
+          if (!(d2 > 0.0))
+            continue;
+          const double f = position_charge_[t] / (d2 * std::sqrt(d2));
+          for (int k = 0; k < 3; ++k)
+            F[k] += f * r[k];
+        }
+      });
+  }
+
+private:
+  /// The Barnes-Hut walk from the root, nearer child first: a node whose
+  /// centre is farther from q than beta times its radius goes to
+  /// `far(i, R, |R|^2)` with R = c - q; a leaf that is not goes to
+  /// `leaf(b, e)`, its samples [b, e) in tree order.
+  template <typename Far, typename Leaf>
+  void traverse(const double q[3], double beta2, const Far& far, const Leaf& leaf) const
+  {
+    if (nodes_.empty())
       return;
     const std::size_t first_leaf = (std::size_t(1) << depth_) - 1;
     std::size_t stack[128];
@@ -298,37 +318,19 @@ public:
     while (top > 0) {
       const std::size_t i = stack[--top];
       const Winding_node& node = nodes_[i];
-      const double R[3] = {node.center[0] - x[0], node.center[1] - x[1], node.center[2] - x[2]};
+      const double R[3] = {node.center[0] - q[0], node.center[1] - q[1], node.center[2] - q[2]};
       const double dist2 = R[0] * R[0] + R[1] * R[1] + R[2] * R[2];
       if (dist2 > beta2 * node.radius * node.radius) {
-        // F = -Q R / d^3 - D / d^3 + 3 (D . R) R / d^5, with R = c - x
-        const Charge_node& c = charges_[i];
-        const double d2 = dist2 + e2;
-        const double inv_d3 = 1.0 / (d2 * std::sqrt(d2));
-        const double DR = c.moment[0] * R[0] + c.moment[1] * R[1] + c.moment[2] * R[2];
-        for (int k = 0; k < 3; ++k)
-          F[k] += (-c.charge * R[k] - c.moment[k] + 3.0 * DR * R[k] / d2) * inv_d3;
+        far(i, R, dist2);
       } else if (i >= first_leaf) {
         const std::size_t j = i - first_leaf;
-        for (std::size_t t = range_begin(depth_, j); t < range_begin(depth_, j + 1); ++t) {
-          const Winding_sample& s = samples_[t];
-          const double r[3] = {x[0] - s.p[0], x[1] - s.p[1], x[2] - s.p[2]};
-          const double d2 = r[0] * r[0] + r[1] * r[1] + r[2] * r[2] + e2;
-          if (!(d2 > 0.0))
-            continue;
-          const double f = charge_of_position(t) / (d2 * std::sqrt(d2));
-          for (int k = 0; k < 3; ++k)
-            F[k] += f * r[k];
-        }
-      } else {
+        leaf(range_begin(depth_, j), range_begin(depth_, j + 1));
+      } else { // the far child first, so that the near one is summed first
         stack[top++] = 2 * i + 2;
         stack[top++] = 2 * i + 1;
       }
     }
   }
-
-private:
-  double charge_of_position(std::size_t t) const { return position_charge_[t]; }
 
   std::size_t range_begin(unsigned int d, std::size_t j) const
   {
