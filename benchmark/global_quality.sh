@@ -90,7 +90,8 @@ if [[ -n "$ipsr" ]]; then
 fi
 
 # The two runs of ours.
-if "$ours" --help 2>&1 | grep -q -- --global; then
+help_text=$("$ours" --help 2>&1 || true) # (not piped into grep -q: SIGPIPE under pipefail)
+if [[ "$help_text" == *--global* ]]; then
   before_args=(--global none)
   before_note="\`orient_normals --global none\`"
   same_program=0

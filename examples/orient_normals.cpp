@@ -186,7 +186,8 @@ NO::Orientation_result orient_in_core(Range& range, const Np& np, const Cli::Opt
     const auto policies = np.flip_criterion(criterion)
                             .solver(solver)
                             .component_sign(Cli::Component_sign(o))
-                            .global_orientation(Cli::global_orientation(o));
+                            .global_orientation(Cli::global_orientation(o))
+                            .up_direction(o.up);
     if (!prior.empty())
       return NO::orient_normals(range, policies.orientation_prior_map(CGAL::make_property_map(prior)));
     return NO::orient_normals(range, policies);
@@ -313,7 +314,8 @@ Cli::Streamed_run orient_streamed(const Cli::Options& o, Cli::Progress_bar& bar)
     const auto policies = np.flip_criterion(criterion)
                             .solver(solver)
                             .component_sign(Cli::Component_sign(o))
-                            .global_orientation(Cli::global_orientation(o));
+                            .global_orientation(Cli::global_orientation(o))
+                            .up_direction(o.up);
     if (o.prior_weight > 0.0)
       return orient(policies.orientation_prior_map(
         Cli::Record_viewpoint_prior{{{o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]}}, o.prior_weight}));

@@ -365,7 +365,13 @@ check "no output for --keep-order into another format" test ! -e "$dir/kept.ply"
 
 # the global sign stage: on by default, reported in the JSON; --global none turns it off
 expect_exit 0 "default: global stage in the json" "$prog" --quiet --json "$dir/sphere.xyz" "$dir/g_default.xyz"
-check "json has a global object with a closedness" grep -q '"global": {"stage": "winding", "closedness": ' "$dir/out.txt"
+check "json has a global object with a closedness" grep -q '"global": {"stage": "visibility", "closedness": ' "$dir/out.txt"
+check "json reports the seen side" grep -q '"seen_components_flipped": [0-9]*, "seen_patches_flipped": [0-9]*, "seen_vetoes": ' "$dir/out.txt"
+expect_exit 0 "--global winding" "$prog" --quiet --json --global winding "$dir/sphere.xyz" "$dir/g_winding.xyz"
+check "json global stage is winding with --global winding" grep -q '"global": {"stage": "winding"' "$dir/out.txt"
+expect_exit 0 "--up 0,1,0" "$prog" --quiet --json --up 0,1,0 "$dir/sphere.xyz" "$dir/g_up.xyz"
+check "a sphere faces outward whatever the up direction" awk '{ if ($1*$4 + $2*$5 + $3*$6 <= 0) bad++ } END { exit bad > 0 }' \
+  "$dir/g_up.xyz"
 expect_exit 0 "--global none" "$prog" --quiet --json --global none "$dir/sphere.xyz" "$dir/g_none.xyz"
 check "json global is null with --global none" grep -q '"global": null' "$dir/out.txt"
 expect_exit 0 "--viewpoint: no global stage by default" "$prog" --quiet --json --viewpoint 0,0,0 "$dir/sphere.xyz" \
@@ -374,7 +380,7 @@ check "json global is null with --viewpoint" grep -q '"global": null' "$dir/out.
 check "with --viewpoint 0,0,0 every normal points inward" awk '{ if ($1*$4 + $2*$5 + $3*$6 >= 0) bad++ } END { exit bad > 0 }' \
   "$dir/g_vp.xyz"
 expect_exit 0 "--stream: global stage in the json" "$prog" --quiet --json --stream "$dir/sphere.xyz" "$dir/g_stream.xyz"
-check "streamed json has a global object" grep -q '"global": {"stage": "winding"' "$dir/out.txt"
+check "streamed json has a global object" grep -q '"global": {"stage": "visibility"' "$dir/out.txt"
 expect_exit 0 "--stream --global none" "$prog" --quiet --json --stream --global none "$dir/sphere.xyz" "$dir/g_sn.xyz"
 check "streamed json global is null with --global none" grep -q '"global": null' "$dir/out.txt"
 
@@ -386,7 +392,7 @@ for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--or
     "--stream --min-component-size -1" "--stream --min-component-size x" "--write-segments" \
     "--stream --write-segments" "--batch-size 10" "--stream --batch-size 0" "--stream --batch-size x" \
     "--keep-order" "--stream --keep-order --ascii" "--stream --keep-order --write-segments" "--refine 1" \
-    "--stream --refine 65" "--stream --refine x" "--global foo" "--global" "--stream --global x"; do
+    "--stream --refine 65" "--stream --refine x" "--global foo" "--global" "--stream --global x" "--up 1,2" "--up" "--up 0,0,nan" "--stream --up x,y,z"; do
   # shellcheck disable=SC2086
   expect_exit 2 "bad option $args" "$prog" $args "$dir/sphere.xyz" "$dir/bad_opt.xyz"
   check "one-line error for $args" test "$(wc -l < "$dir/err.txt")" -eq 1

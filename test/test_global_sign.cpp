@@ -6,6 +6,7 @@
 // wrong minimum (nested, touching and flat-faced closed objects), with the
 // stage and without it; open sheets are left as they were.
 
+#include <Normal_orientation/Exterior_visibility.h>
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/orient_normals.h>
 
@@ -231,7 +232,9 @@ TEST(Global_sign, DefaultIsWindingUnlessTheUserSaysWhichSide)
   std::vector<Point_with_normal> cloud = NO::test::unoriented(s, rng);
   const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
                     .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
-  EXPECT_TRUE(NO::orient_normals(cloud, np).global.ran);
+  const NO::Orientation_result r = NO::orient_normals(cloud, np);
+  EXPECT_TRUE(r.global.ran);
+  EXPECT_TRUE(r.global.visibility);
   EXPECT_EQ(NO::test::count_wrong(s, cloud), 0u);
   EXPECT_FALSE(NO::orient_normals(cloud, np.component_sign(NO::Viewpoint_component_sign(0.0, 0.0, 0.0))).global.ran);
   EXPECT_TRUE(NO::orient_normals(cloud, np.component_sign(NO::Viewpoint_component_sign(0.0, 0.0, 0.0))
@@ -250,6 +253,152 @@ TEST(Global_sign, SameOutputForOneAndTwoThreads)
   NO::orient_normals(a, np.number_of_threads(1));
   NO::orient_normals(b, np.number_of_threads(2));
   EXPECT_TRUE(a == b);
+}
+
+namespace {
+
+/// the mean of `vote`, weighted by `areas`
+double mean_vote(const std::vector<double>& vote, const std::vector<double>& areas)
+{
+  double s = 0.0, a = 0.0;
+  for (std::size_t j = 0; j < vote.size(); ++j) {
+    s += areas[j] * vote[j];
+    a += areas[j];
+  }
+  return s / a;
+}
+
+/// the votes of exterior_visibility() for samples with their normals times `sign`
+std::vector<double> visibility_votes(const std::vector<Sample>& s, double sign, std::vector<double>& areas,
+                                     const NO::Exterior_visibility_options& options = {})
+{
+  std::vector<Point> p;
+  std::vector<Vector> n;
+  for (const Sample& t : s) {
+    p.push_back(t.p);
+    n.push_back(sign * t.n);
+  }
+  areas = NO::estimate_point_areas<CGAL::Sequential_tag>(p, n);
+  return NO::exterior_visibility<CGAL::Sequential_tag>(p, n, areas, options);
+}
+
+/// `s` turned so that its +z axis becomes +y: (x, y, z) -> (x, z, -y)
+std::vector<Sample> z_up_to_y_up(const std::vector<Sample>& s)
+{
+  std::vector<Sample> out;
+  for (const Sample& t : s)
+    out.push_back({Point(t.p.x(), t.p.z(), -t.p.y()), Vector(t.n.x(), t.n.z(), -t.n.y())});
+  return out;
+}
+
+} // namespace
+
+TEST(Exterior_visibility, VotesOfAClosedSurfaceAndOfASheet)
+{
+  std::mt19937_64 rng(16);
+  const std::vector<Sample> ball = NO::test::sphere(4000, rng);
+  std::vector<double> areas;
+  // outward normals face every view that sees them (a few samples at the
+  // bottom, seen only from below and at a graze, may be hidden in all 64)
+  std::vector<double> out = visibility_votes(ball, 1.0, areas), in = visibility_votes(ball, -1.0, areas);
+  std::size_t unseen = 0;
+  for (std::size_t j = 0; j < ball.size(); ++j) {
+    EXPECT_GE(out[j], 0.0);
+    EXPECT_DOUBLE_EQ(in[j], -out[j]);
+    unseen += out[j] == 0.0 ? 1 : 0;
+  }
+  EXPECT_LE(unseen, ball.size() / 100);
+  EXPECT_GT(mean_vote(out, areas), 0.15);
+  // a flat sheet, normals up: seen from both sides, up only by the up direction
+  std::vector<Sample> sheet;
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int i = 0; i < 4000; ++i)
+    sheet.push_back({Point(u(rng), u(rng), 0.0), Vector(0, 0, 1)});
+  NO::Exterior_visibility_options o;
+  EXPECT_GT(mean_vote(visibility_votes(sheet, 1.0, areas, o), areas), 0.2);
+  o.up = {{0.0, 0.0, -2.0}};
+  EXPECT_LT(mean_vote(visibility_votes(sheet, 1.0, areas, o), areas), -0.2);
+  o.up = {{0.0, 0.0, 0.0}};
+  EXPECT_LT(std::abs(mean_vote(visibility_votes(sheet, 1.0, areas, o), areas)), 0.02);
+  // the same votes for any thread count
+  std::vector<Point> p;
+  std::vector<Vector> n;
+  for (const Sample& t : ball) {
+    p.push_back(t.p);
+    n.push_back(t.n);
+  }
+  areas = NO::estimate_point_areas<CGAL::Sequential_tag>(p, n);
+  const std::vector<double> one = NO::exterior_visibility<CGAL::Sequential_tag>(p, n, areas);
+  tbb::global_control two_threads(tbb::global_control::max_allowed_parallelism, 2);
+  EXPECT_TRUE(one == NO::exterior_visibility<CGAL::Parallel_tag>(p, n, areas));
+}
+
+TEST(Exterior_visibility, BadInputThrows)
+{
+  std::vector<Point> p = {Point(0, 0, 0), Point(1, 0, 0)};
+  std::vector<Vector> n = {Vector(0, 0, 1), Vector(0, 0, 1)};
+  std::vector<double> a = {1.0, 1.0};
+  EXPECT_THROW(NO::exterior_visibility(p, n, std::vector<double>{1.0}), std::invalid_argument);
+  EXPECT_THROW(NO::exterior_visibility(p, n, std::vector<double>{1.0, std::nan("")}), std::invalid_argument);
+  EXPECT_THROW(NO::exterior_visibility(p, n, std::vector<double>{1.0, -1.0}), std::invalid_argument);
+  NO::Exterior_visibility_options o;
+  o.number_of_directions = 0;
+  EXPECT_THROW(NO::exterior_visibility(p, n, a, o), std::invalid_argument);
+  o = NO::Exterior_visibility_options();
+  o.up[1] = std::nan("");
+  EXPECT_THROW(NO::exterior_visibility(p, n, a, o), std::invalid_argument);
+  o = NO::Exterior_visibility_options();
+  o.below_horizon_weight = -0.5;
+  EXPECT_THROW(NO::exterior_visibility(p, n, a, o), std::invalid_argument);
+  EXPECT_THROW(NO::visibility_flips({0.1, -0.1}, a, {0, 2}, {1, 1}), std::invalid_argument);
+  EXPECT_EQ(NO::visibility_flips({0.1, -0.1}, a, {0, 1}, {1, 1}), (std::vector<char>{0, 1}));
+  EXPECT_EQ(NO::visibility_flips({0.1, -0.1}, a, {0, 1}, {1, 0}), (std::vector<char>{0, 0}));
+  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
+                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  std::vector<Point_with_normal> cloud = {{Point(0, 0, 0), Vector(0, 0, 1)}, {Point(1, 0, 0), Vector(0, 0, 1)}};
+  EXPECT_THROW(NO::orient_normals(cloud, np.up_direction(Vector(0, std::nan(""), 1))), std::invalid_argument);
+}
+
+TEST(Global_sign, OpenScansFaceTheSideTheyWereSeenFrom)
+{
+  // A terrain with buildings (no floors, no ground under them): the winding
+  // number alone leaves it as the outward vote made it, ground and roofs
+  // down; exterior visibility turns it up, from random signs and from its own
+  // consistent normals alike.
+  std::mt19937_64 rng(17);
+  const std::vector<Sample> tile = NO::hard_shapes::terrain_with_buildings(20000, rng);
+  const double n = double(tile.size());
+  NO::Orientation_result r;
+  EXPECT_LE(double(orient_and_count(tile, NO::Global_orientation::VISIBILITY_AND_WINDING, 22, &r)) / n, 0.01);
+  EXPECT_TRUE(r.global.visibility);
+  EXPECT_GE(double(orient_and_count(tile, NO::Global_orientation::WINDING, 22)) / n, 0.5);
+  std::vector<Point_with_normal> given;
+  for (const Sample& t : tile)
+    given.emplace_back(t.p, t.n);
+  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
+                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  EXPECT_TRUE(NO::orient_normals(given, np).global.visibility); // the default
+  EXPECT_LE(double(NO::test::count_wrong(tile, given)) / n, 0.01);
+  // the same tile with +y up: right when the up direction says so
+  const std::vector<Sample> turned = z_up_to_y_up(tile);
+  std::mt19937_64 signs(23);
+  std::vector<Point_with_normal> cloud = NO::test::unoriented(turned, signs);
+  NO::orient_normals(cloud, np.up_direction(Vector(0, 1, 0)));
+  EXPECT_LE(double(NO::test::count_wrong(turned, cloud)) / n, 0.01);
+  // an urban tile whose alleys the winding number mistakes for closed walls
+  std::mt19937_64 g(1);
+  const std::vector<Sample> city = NO::hard_shapes::city_block(20000, g);
+  EXPECT_LE(double(orient_and_count(city, NO::Global_orientation::VISIBILITY_AND_WINDING, 24, &r)) / n, 0.05);
+  EXPECT_GE(r.global.seen_components_flipped, 1u);
+  EXPECT_GE(double(orient_and_count(city, NO::Global_orientation::WINDING, 24)) / n, 0.3);
+  // the other open scans and the closed classes keep what the winding number gets
+  for (const char* name : {"open_box", "single_view_scan", "hollow_ball", "bored_cylinder"}) {
+    std::mt19937_64 g(1);
+    const std::vector<Sample> s = NO::hard_shapes::hard_shape(name, 20000, g);
+    EXPECT_LE(double(orient_and_count(s, NO::Global_orientation::VISIBILITY_AND_WINDING, 21)) / double(s.size()),
+              0.01)
+      << name;
+  }
 }
 
 TEST(Global_sign, HardShapesOfTheFailureClasses)

@@ -11,6 +11,7 @@
 #include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/streaming/Streaming_settings.h>
 
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -43,7 +44,8 @@ struct Options
   bool has_viewpoint = false;          ///< --viewpoint was given
   double viewpoint[3] = {0, 0, 0};     ///< --viewpoint
   double prior_weight = 0.0;           ///< --prior-weight (0: no prior)
-  std::string global = "auto";         ///< --global: auto, winding or none
+  std::string global = "auto";         ///< --global: auto, visibility, winding or none
+  std::array<double, 3> up = {{0, 0, 1}}; ///< --up
   std::string normals = "jet";         ///< --normals
   unsigned int normal_k = 18;          ///< --normal-k
   int threads = 0;                     ///< --threads (0: all cores)
@@ -86,9 +88,13 @@ inline const char* usage_text()
          "  --prior-weight W     with --viewpoint: also a soft prior for every point to face\n"
          "                       it, of weight W * cos(angle) (edges weigh at most 1), which\n"
          "                       every solver weighs against the edges (default 0: none)\n"
-         "  --global NAME        global sign stage: winding (the winding number of the cloud\n"
-         "                       decides the signs of patches where it is closed) or none;\n"
-         "                       default auto: winding with the outward sign and no viewpoint\n"
+         "  --global NAME        global sign stage: visibility (components and sheets face the\n"
+         "                       side they were seen from, then the winding number decides\n"
+         "                       where the cloud is closed), winding (the winding number\n"
+         "                       only) or none; default auto: visibility with the outward\n"
+         "                       sign and no viewpoint, none otherwise\n"
+         "  --up X,Y,Z           the scene's up direction, for visibility: views from below\n"
+         "                       weigh less (default 0,0,1; 0,0,0: no up direction)\n"
          "  --normals NAME       estimator when IN has no normals: jet (default), pca\n"
          "  --normal-k N         neighbours of the normal estimator (default 18)\n"
          "  --threads N          at most N threads (default, or 0: all cores); the output\n"
@@ -185,8 +191,17 @@ bool read_option(Options& o, const std::string& a, const Value& value)
       throw Usage_error("unknown sign policy '" + o.sign + "' (outward, keep)");
   } else if (a == "--global") {
     o.global = value();
-    if (o.global != "auto" && o.global != "winding" && o.global != "none")
-      throw Usage_error("unknown global stage '" + o.global + "' (auto, winding, none)");
+    if (o.global != "auto" && o.global != "visibility" && o.global != "winding" && o.global != "none")
+      throw Usage_error("unknown global stage '" + o.global + "' (auto, visibility, winding, none)");
+  } else if (a == "--up") {
+    std::string v = value();
+    for (char& c : v)
+      if (c == ',')
+        c = ' ';
+    std::istringstream in(v);
+    if (!(in >> o.up[0] >> o.up[1] >> o.up[2]) || !(in >> std::ws).eof() ||
+        !std::isfinite(o.up[0] + o.up[1] + o.up[2]))
+      throw Usage_error("--up needs X,Y,Z");
   } else if (a == "--viewpoint") {
     std::string v = value();
     for (char& c : v)

@@ -59,10 +59,13 @@ inline void print_global(const Normal_orientation::Global_sign_summary& g)
 {
   if (g.ran)
     std::fprintf(stderr,
-                 "global stage (winding): %zu patch%s, %zu flipped; closedness %.3f, %zu closed and %zu open "
-                 "component%s, %.3f s\n",
-                 g.number_of_patches, g.number_of_patches == 1 ? "" : "es", g.patches_flipped, g.closedness,
-                 g.closed_components, g.open_components, plural(g.open_components), g.seconds);
+                 "global stage (%s): %zu patch%s, %zu flipped; closedness %.3f, %zu closed and %zu open "
+                 "component%s; seen side: %zu component%s and %zu sheet%s flipped, %zu veto%s; %.3f s\n",
+                 g.visibility ? "visibility, winding" : "winding", g.number_of_patches,
+                 g.number_of_patches == 1 ? "" : "es", g.patches_flipped, g.closedness, g.closed_components,
+                 g.open_components, plural(g.open_components), g.seen_components_flipped,
+                 plural(g.seen_components_flipped), g.seen_patches_flipped, plural(g.seen_patches_flipped),
+                 g.seen_vetoes, g.seen_vetoes == 1 ? "" : "es", g.seconds);
 }
 
 /// "global": what the global sign stage saw and did (null when it did not run)
@@ -74,11 +77,13 @@ inline void json_global(Json_writer& j, const Normal_orientation::Global_sign_su
     return;
   }
   j.begin_object();
-  j.key("stage").string("winding").key("closedness").number(g.closedness);
+  j.key("stage").string(g.visibility ? "visibility" : "winding").key("closedness").number(g.closedness);
   j.key("samples").integer(g.number_of_samples).key("patches").integer(g.number_of_patches);
   j.key("patches_flipped").integer(g.patches_flipped).key("points_flipped").integer(g.points_flipped);
   j.key("closed_components").integer(g.closed_components).key("open_components").integer(g.open_components);
   j.key("rounds").integer(g.rounds);
+  j.key("seen_components_flipped").integer(g.seen_components_flipped);
+  j.key("seen_patches_flipped").integer(g.seen_patches_flipped).key("seen_vetoes").integer(g.seen_vetoes);
   j.key("energy_before").number(g.energy_before).key("energy_after").number(g.energy_after);
   j.key("seconds").fixed(g.seconds);
   j.end_object();

@@ -90,14 +90,16 @@ private:
   Normal_orientation::Viewpoint_component_sign m_viewpoint;
 };
 
-/// The global stage of --global: `WINDING` for "winding", and for "auto"
-/// when the components face outward (no --viewpoint, no --sign keep);
-/// `NONE` otherwise.
+/// The global stage of --global: `VISIBILITY_AND_WINDING` for "visibility",
+/// and for "auto" when the components face outward (no --viewpoint, no
+/// --sign keep); `WINDING` for "winding"; `NONE` otherwise.
 inline Normal_orientation::Global_orientation global_orientation(const Options& o)
 {
+  typedef Normal_orientation::Global_orientation G;
   const bool automatic = o.global == "auto" && !o.has_viewpoint && o.sign == "outward" && o.prior_weight == 0.0;
-  return o.global == "winding" || automatic ? Normal_orientation::Global_orientation::WINDING
-                                            : Normal_orientation::Global_orientation::NONE;
+  if (o.global == "visibility" || automatic)
+    return G::VISIBILITY_AND_WINDING;
+  return o.global == "winding" ? G::WINDING : G::NONE;
 }
 
 /// a_i = W cos(angle between n_i and p_i -> viewpoint), or 0 when n_i or

@@ -30,8 +30,13 @@ namespace Normal_orientation {
 /// Whether the drivers run the global sign stage after the component signs.
 enum class Global_orientation
 {
-  NONE,   ///< no global stage: the component sign policy has the last word
-  WINDING ///< the winding number decides the signs of patches where the cloud is closed
+  NONE,    ///< no global stage: the component sign policy has the last word
+  WINDING, ///< the winding number decides the signs of patches where the cloud is closed
+  /// first exterior visibility: components and sheets face the side they
+  /// were seen from (`exterior_visibility()`, with an up direction); then
+  /// the winding number decides where the cloud is closed, except where it
+  /// would turn a component away from the side it was seen from
+  VISIBILITY_AND_WINDING
 };
 
 /// \ingroup PkgNormalOrientationGlobal

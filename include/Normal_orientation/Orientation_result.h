@@ -19,12 +19,16 @@ namespace Normal_orientation {
 struct Global_sign_summary
 {
   bool ran = false;                    ///< false when the stage was off or had nothing to decide
+  bool visibility = false;             ///< exterior visibility ran first (`Global_orientation::VISIBILITY_AND_WINDING`)
   std::size_t number_of_samples = 0;   ///< points the field was built on (a subsample of large clouds)
   std::size_t number_of_patches = 0;   ///< patches whose signs were decided
   std::size_t patches_flipped = 0;     ///< patches the stage negated
   std::uint64_t points_flipped = 0;    ///< points of those patches (in core; 0 streamed)
   std::size_t closed_components = 0;   ///< components found closed: the stage's signs were kept there
-  std::size_t open_components = 0;     ///< components found open: the stage left them as they were
+  std::size_t open_components = 0;     ///< components found open: they keep the signs they had before the winding number
+  std::size_t seen_components_flipped = 0; ///< components negated to face the side they were seen from
+  std::size_t seen_patches_flipped = 0;    ///< sheets (in core) or segments (streamed) negated so, after their components
+  std::size_t seen_vetoes = 0;             ///< components where the winding number's flips were undone, since they made them face away from where they were seen
   unsigned int rounds = 0;             ///< rounds of patch flips
   /// the fraction of the sampled area where w is within the tolerance of
   /// 1/2, after the stage: near 1 on closed surfaces, low on open scans

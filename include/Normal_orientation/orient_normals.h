@@ -63,7 +63,7 @@ struct Policies
   FlipCriterion criterion;
   Solver solver;
   SignPolicy sign_policy;
-  Global_orientation global;
+  Global_settings global;
   /// writes their names into `result`
   void name(Orientation_summary& result) const
   {
@@ -77,9 +77,9 @@ struct Policies
 /// global stage of `np`, with the defaults of both drivers:
 /// `Hoppe_criterion`, `Qpbo_i_solver(3, seed)`, `Outward_component_sign`
 /// (or `Constrained_component_sign<>` when there are constraints), and
-/// `Global_orientation::WINDING` when the sign policy is the default and
-/// there are no constraints or priors (which say what the user wants),
-/// `Global_orientation::NONE` otherwise.
+/// `Global_orientation::VISIBILITY_AND_WINDING` when the sign policy is the
+/// default and there are no constraints or priors (which say what the user
+/// wants), `Global_orientation::NONE` otherwise; the up direction +z.
 template <typename NamedParameters>
 auto read_policies(const NamedParameters& np, unsigned long seed)
 {
@@ -95,8 +95,14 @@ auto read_policies(const NamedParameters& np, unsigned long seed)
                               || Unary_parameters<NamedParameters>::has_prior
                               || !CGAL::parameters::is_default_parameter<NamedParameters,
                                                                          internal_np::component_sign_t>::value;
-  const Global_orientation global = choose_parameter(get_parameter(np, internal_np::global_orientation),
-                                                     user_signs ? Global_orientation::NONE : Global_orientation::WINDING);
+  Global_settings global;
+  global.orientation = choose_parameter(get_parameter(np, internal_np::global_orientation),
+                                        user_signs ? Global_orientation::NONE
+                                                   : Global_orientation::VISIBILITY_AND_WINDING);
+  global.up = direction_array(choose_parameter(get_parameter(np, internal_np::up_direction), global.up));
+  for (double c : global.up)
+    if (!std::isfinite(c))
+      throw std::invalid_argument("orient_normals: up_direction is not finite");
   return Policies<decltype(criterion), decltype(solver), decltype(sign_policy)>{criterion, solver, sign_policy,
                                                                                  global};
 }
@@ -312,11 +318,18 @@ Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, Weig
 ///     \cgalParamDefault{`Outward_component_sign()`, or `Constrained_component_sign<>()` when `point_is_constrained_map` is given}
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{global_orientation}
-///     \cgalParamDescription{the global sign stage after the component signs: the winding number of the
+///     \cgalParamDescription{the global sign stage after the component signs: components and sheets
+///       face the side they were seen from (`exterior_visibility()`), then the winding number of the
 ///       whole cloud decides the signs of patches where it is closed (see `decide_patch_signs()`)}
 ///     \cgalParamType{`Global_orientation`}
-///     \cgalParamDefault{`Global_orientation::WINDING` with the default `component_sign` and without
-///       constraints or priors, `Global_orientation::NONE` otherwise}
+///     \cgalParamDefault{`Global_orientation::VISIBILITY_AND_WINDING` with the default `component_sign`
+///       and without constraints or priors, `Global_orientation::NONE` otherwise}
+///   \cgalParamNEnd
+///   \cgalParamNBegin{up_direction}
+///     \cgalParamDescription{the scene's up direction for exterior visibility: views from below weigh
+///       less; a zero vector gives no side a preference}
+///     \cgalParamType{`Kernel::Vector_3`}
+///     \cgalParamDefault{`Kernel::Vector_3(0, 0, 1)`}
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{point_is_constrained_map}
 ///     \cgalParamDescription{points whose input normal is known to be correctly oriented: hard
@@ -441,11 +454,12 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       result.seconds.sign = internal::seconds_since(t);
       progress.part(Stage::SIGN, 0.9, 0.92).report(1.0);
 
-      // 5. The global stage: the winding number decides the signs of patches.
-      if (policies.global == Global_orientation::WINDING) {
+      // 5. The global stage: exterior visibility and the winding number decide the signs of patches.
+      if (policies.global.orientation != Global_orientation::NONE) {
         progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
         result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(graph, in.points, in.normals, component,
-                                                                            gr.radius, has_unary, labels);
+                                                                            gr.radius, has_unary, policies.global,
+                                                                            labels);
         result.seconds.global = result.global.seconds;
       }
       result.energy_after = energy(graph, weight, label_map);

@@ -145,7 +145,8 @@ std::uint64_t scan_and_radius_stages(Source& source, const Streaming_settings& s
 template <typename ConcurrencyTag, typename Kernel, typename Source, typename Sink, typename FlipCriterion,
           typename Solver, typename SignPolicy, typename Unary>
 void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, const FlipCriterion& criterion,
-                const Solver& solver, const SignPolicy& sign_policy, Global_orientation global, Unary unary,
+                const Solver& solver, const SignPolicy& sign_policy,
+                const Normal_orientation::internal::Global_settings& global, Unary unary,
                 const Run_hooks& hooks, Streaming_result& result)
 {
   using Normal_orientation::internal::seconds_since;
@@ -255,16 +256,17 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   // 7. The sign of every component.
   t = Clock::now();
   Labelled_reader points(records, labels);
-  const std::vector<char> flip_component = sign_stage(
+  std::vector<char> flip_component = sign_stage(
     sign_policy, [&unary](const Point_record& r) { return unary.is_constrained(r); }, points, solution.component,
     solution.number_of_components, swept.segment_size, swept.segment_has_unary, radius, n, stage(Stage::SIGN));
   result.seconds.sign = seconds_since(t);
 
-  // 8. The global stage: the winding number of a subsample decides the signs of segments.
-  if (global == Global_orientation::WINDING) {
+  // 8. The global stage: exterior visibility, then the winding number, of a subsample decide
+  // the signs of components and segments.
+  if (global.orientation != Global_orientation::NONE) {
     t = Clock::now();
     result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component,
-                                                 swept.segment_has_unary, radius, n, stage(Stage::GLOBAL));
+                                                 swept.segment_has_unary, radius, n, global, stage(Stage::GLOBAL));
     result.seconds.global = seconds_since(t);
     if (labels.point_flip) // (point by point: the energy of the output is not measured)
       result.energy_after = std::numeric_limits<double>::quiet_NaN();

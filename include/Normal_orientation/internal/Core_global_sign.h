@@ -8,6 +8,7 @@
 /// graph and the labels, a bounded subsample with areas, and
 /// `decide_patch_signs()`.
 
+#include <Normal_orientation/Exterior_visibility.h>
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/Orientation_problem.h>
@@ -15,10 +16,12 @@
 #include <Normal_orientation/Winding_number_field.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <numeric>
 #include <vector>
 
 /// \cond SKIP_IN_MANUAL
@@ -131,50 +134,155 @@ inline void add_level(Global_sign_summary& total, const Global_sign_summary& lev
   total.energy_after = level.energy_after;
 }
 
-/// The global stage on the in-core arrays (points in Morton order): flips
-/// `labels` of the patches that `decide_patch_signs()` negates.  Patches
-/// with a point of `has_unary` keep their sign.
-template <typename ConcurrencyTag, typename Kernel>
-Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
-                                      const std::vector<typename Kernel::Vector_3>& normals,
-                                      const std::vector<std::uint32_t>& component, double radius,
-                                      const std::vector<char>& has_unary, std::vector<Label>& labels)
+/// What the drivers' global stage does: its mode, and the up direction of
+/// exterior visibility (zero: none).
+struct Global_settings
 {
-  typedef typename Kernel::Point_3 Point;
-  typedef typename Kernel::Vector_3 Vector;
-  const auto t0 = std::chrono::steady_clock::now();
+  Global_orientation orientation = Global_orientation::NONE;
+  std::array<double, 3> up = {{0.0, 0.0, 1.0}};
+  /// the options of `exterior_visibility()`
+  Exterior_visibility_options visibility() const
+  {
+    Exterior_visibility_options o;
+    o.up = up;
+    return o;
+  }
+};
+
+/// `v` as an array (the `up_direction` parameter: a `std::array<double, 3>`)
+inline std::array<double, 3> direction_array(const std::array<double, 3>& v) { return v; }
+/// `v` as an array (the `up_direction` parameter: a vector with x(), y(), z())
+template <typename Vector>
+std::array<double, 3> direction_array(const Vector& v)
+{
+  return {{double(v.x()), double(v.y()), double(v.z())}};
+}
+
+/// The decisions of exterior visibility.
+struct Seen_side_flips
+{
+  std::vector<char> component; ///< per component id: the whole component negates
+  std::vector<char> patch;     ///< per patch id: the patch negates (after its component)
+  std::vector<double> vote;    ///< per sample: `exterior_visibility()` of the input orientation
+  std::size_t components_flipped = 0;
+  std::size_t patches_flipped = 0;
+};
+
+/// The components (ids below `number_of_components`, those of `fixed`
+/// left out) that face away from the side they were seen from
+/// (`exterior_visibility()` of the samples, with their oriented normals),
+/// then the patches of `sample_patch` that still do; nothing unless
+/// `settings` asks for visibility.
+template <typename ConcurrencyTag, typename Point, typename Vector>
+Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vector<Vector>& oriented,
+                                const std::vector<double>& areas, const std::vector<std::uint32_t>& sample_component,
+                                const std::vector<std::uint32_t>& sample_patch, std::size_t number_of_components,
+                                std::size_t number_of_patches, const std::vector<char>& fixed,
+                                const Global_settings& settings)
+{
+  Seen_side_flips out;
+  out.component.assign(number_of_components, 0);
+  out.patch.assign(number_of_patches, 0);
+  out.vote.assign(points.size(), 0.0);
+  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
+    return out;
+  std::vector<char> free_component(number_of_components, 1), free_patch(number_of_patches, 0);
+  for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
+    free_component[c] = !fixed[c];
+  out.vote = exterior_visibility<ConcurrencyTag>(points, oriented, areas, settings.visibility());
+  std::vector<double> vote = out.vote;
+  out.component = visibility_flips(vote, areas, sample_component, free_component);
+  for (std::size_t j = 0; j < vote.size(); ++j) {
+    free_patch[sample_patch[j]] = free_component[sample_component[j]];
+    if (out.component[sample_component[j]])
+      vote[j] = -vote[j];
+  }
+  out.patch = visibility_flips(vote, areas, sample_patch, free_patch);
+  for (char f : out.component)
+    out.components_flipped += f ? 1 : 0;
+  for (char f : out.patch)
+    out.patches_flipped += f ? 1 : 0;
+  return out;
+}
+
+/// The components (groups of `sample_group`) where the winding number's
+/// flips must be undone: those where it flipped samples (`flipped`) and
+/// that, with their final signs (`sign` times the input orientation of
+/// `vote`), face away from the side they were seen from (area-weighted
+/// mean vote below `-margin`).
+inline std::vector<char> seen_side_vetoes(const std::vector<double>& vote, const std::vector<double>& areas,
+                                          const std::vector<std::uint32_t>& sample_group,
+                                          const std::vector<char>& flipped, const std::vector<signed char>& sign,
+                                          std::size_t number_of_groups, double margin = 0.01)
+{
+  std::vector<char> eligible(number_of_groups, 0);
+  std::vector<double> final_vote(vote.size());
+  for (std::size_t j = 0; j < vote.size(); ++j) {
+    eligible[sample_group[j]] |= flipped[j];
+    final_vote[j] = double(sign[j]) * vote[j];
+  }
+  return visibility_flips(final_vote, areas, sample_group, eligible, margin);
+}
+
+/// The samples of the in-core global stage: every stride-th point of the
+/// Morton order with a normal (an even subsample), oriented by `labels`.
+template <typename Kernel>
+struct Core_samples
+{
+  std::vector<std::uint32_t> index;                ///< the points sampled
+  std::vector<char> is_sample;                     ///< per point
+  std::vector<typename Kernel::Point_3> points;    ///< their positions
+  std::vector<typename Kernel::Vector_3> oriented; ///< their normals, oriented
+  std::vector<double> areas;                       ///< their capped areas
+  std::vector<std::uint32_t> component;            ///< their components
+};
+
+/// The samples of `points`, with their areas (`estimate_point_areas()`,
+/// capped by `cap_areas()`).
+template <typename ConcurrencyTag, typename Kernel>
+Core_samples<Kernel> core_samples(const std::vector<typename Kernel::Point_3>& points,
+                                  const std::vector<typename Kernel::Vector_3>& normals,
+                                  const std::vector<std::uint32_t>& component, const std::vector<Label>& labels)
+{
+  Core_samples<Kernel> s;
   const std::size_t n = points.size();
-  // Every stride-th point of the Morton order with a normal: an even subsample.
   const std::size_t m = std::max<std::size_t>(1, std::size_t(global_samples(n)));
   const std::size_t stride = std::max<std::size_t>(1, (n + m - 1) / m);
-  std::vector<char> is_sample(n, 0);
-  std::vector<std::uint32_t> sample_index;
+  s.is_sample.assign(n, 0);
   for (std::size_t i = 0; i < n; i += stride)
     if (normals[i] != CGAL::NULL_VECTOR) {
-      is_sample[i] = 1;
-      sample_index.push_back(std::uint32_t(i));
+      s.is_sample[i] = 1;
+      s.index.push_back(std::uint32_t(i));
+      s.points.push_back(points[i]);
+      s.oriented.push_back(normals[i]);
+      s.component.push_back(component[i]);
     }
-  const std::vector<Label> labels_before = labels;
-  std::vector<Point> sp;
-  std::vector<Vector> sn;
-  for (std::uint32_t i : sample_index) {
-    sp.push_back(points[i]);
-    sn.push_back(normals[i]);
-  }
-  std::vector<double> areas = estimate_point_areas<ConcurrencyTag>(sp, sn);
-  cap_areas(areas);
-  for (std::size_t t = 0; t < sample_index.size(); ++t)
-    if (labels[sample_index[t]] < 0)
-      sn[t] = -sn[t];
+  s.areas = estimate_point_areas<ConcurrencyTag>(s.points, s.oriented);
+  cap_areas(s.areas);
+  for (std::size_t t = 0; t < s.index.size(); ++t)
+    if (labels[s.index[t]] < 0)
+      s.oriented[t] = -s.oriented[t];
+  return s;
+}
+
+/// The winding number's levels of patches (`patch_cell_radii`) on the
+/// in-core arrays: flips `labels` and adds the figures to `report`.
+template <typename ConcurrencyTag, typename Kernel>
+void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
+                         const std::vector<typename Kernel::Vector_3>& normals,
+                         const std::vector<std::uint32_t>& component, double radius,
+                         const std::vector<char>& has_unary, const Core_samples<Kernel>& samples,
+                         std::vector<Label>& labels, Global_sign_summary& report)
+{
+  const std::size_t n = points.size();
   Winding_patch_signs<Kernel> search;
-  search.template build<ConcurrencyTag>(sp, sn, areas);
-  Global_sign_summary report;
+  search.template build<ConcurrencyTag>(samples.points, samples.oriented, samples.areas);
   for (double cell_radii : patch_cell_radii) {
     std::size_t np = 0;
     const std::vector<std::uint32_t> patch =
-      build_patches<Kernel>(graph, points, normals, labels, cell_radii * radius, is_sample, np);
+      build_patches<Kernel>(graph, points, normals, labels, cell_radii * radius, samples.is_sample, np);
     std::vector<std::uint32_t> spatch;
-    for (std::uint32_t i : sample_index)
+    for (std::uint32_t i : samples.index)
       spatch.push_back(patch[i]);
     std::vector<std::uint32_t> patch_component(np, 0);
     std::vector<char> fixed(np, 0);
@@ -191,6 +299,71 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
         labels[i] = Label(-labels[i]);
     add_level(report, level);
   }
+}
+
+/// The global stage on the in-core arrays (points in Morton order), on a
+/// subsample: exterior visibility negates the components, then the sheets
+/// (the patches of the first level), that face away from where they were
+/// seen; the winding number then negates patches, level by level, and its
+/// flips are undone in the components they make face away from where they
+/// were seen.  Components with a point of `has_unary` keep their signs.
+template <typename ConcurrencyTag, typename Kernel>
+Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
+                                      const std::vector<typename Kernel::Vector_3>& normals,
+                                      const std::vector<std::uint32_t>& component, double radius,
+                                      const std::vector<char>& has_unary, const Global_settings& settings,
+                                      std::vector<Label>& labels)
+{
+  const auto t0 = std::chrono::steady_clock::now();
+  const std::size_t n = points.size();
+  const std::vector<Label> labels_before = labels;
+  Core_samples<Kernel> samples = core_samples<ConcurrencyTag, Kernel>(points, normals, component, labels);
+  const std::size_t ns = samples.index.size();
+  std::size_t nc = 0;
+  for (std::uint32_t c : component)
+    nc = std::max<std::size_t>(nc, std::size_t(c) + 1);
+  std::vector<char> component_fixed(nc, 0);
+  for (std::size_t i = 0; i < has_unary.size(); ++i)
+    if (has_unary[i])
+      component_fixed[component[i]] = 1;
+  // 1. Exterior visibility.
+  std::size_t number_of_sheets = 0;
+  const std::vector<std::uint32_t> sheet =
+    build_patches<Kernel>(graph, points, normals, labels, 0.0, samples.is_sample, number_of_sheets);
+  std::vector<std::uint32_t> sample_sheet(ns);
+  for (std::size_t t = 0; t < ns; ++t)
+    sample_sheet[t] = sheet[samples.index[t]];
+  const Seen_side_flips seen = seen_side_flips<ConcurrencyTag>(
+    samples.points, samples.oriented, samples.areas, samples.component, sample_sheet, nc, number_of_sheets,
+    component_fixed, settings);
+  for (std::size_t i = 0; i < n; ++i)
+    if (seen.component[component[i]] != seen.patch[sheet[i]])
+      labels[i] = Label(-labels[i]);
+  for (std::size_t t = 0; t < ns; ++t)
+    if (seen.component[samples.component[t]] != seen.patch[sample_sheet[t]])
+      samples.oriented[t] = -samples.oriented[t];
+  const std::vector<Label> seen_labels = labels;
+  // 2. The winding number.
+  Global_sign_summary report;
+  core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, component, radius, has_unary, samples, labels,
+                                              report);
+  // 3. Its flips that make a component face away from where it was seen.
+  std::vector<char> flipped(ns);
+  std::vector<signed char> sign(ns);
+  for (std::size_t t = 0; t < ns; ++t) {
+    const std::uint32_t i = samples.index[t];
+    flipped[t] = labels[i] != seen_labels[i];
+    sign[t] = labels[i] == labels_before[i] ? 1 : -1;
+  }
+  const std::vector<char> veto = seen_side_vetoes(seen.vote, samples.areas, samples.component, flipped, sign, nc);
+  for (std::size_t i = 0; i < n; ++i)
+    if (veto[component[i]])
+      labels[i] = seen_labels[i];
+  report.visibility = settings.orientation == Global_orientation::VISIBILITY_AND_WINDING;
+  report.seen_components_flipped = seen.components_flipped;
+  report.seen_patches_flipped = seen.patches_flipped;
+  for (char v : veto)
+    report.seen_vetoes += v ? 1 : 0;
   report.points_flipped = 0;
   for (std::size_t i = 0; i < n; ++i)
     report.points_flipped += labels_before[i] != labels[i] ? 1 : 0;

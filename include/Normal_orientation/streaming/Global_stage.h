@@ -114,13 +114,13 @@ struct Global_point_flips
   std::vector<char> flip;                              ///< per sample
   std::unordered_map<std::uint32_t, char> segment_flip; ///< per final segment with samples: the majority
   const std::vector<std::uint32_t>* segment_component = nullptr; ///< per sweep segment
-  const std::vector<char>* flip_component = nullptr;
+  std::vector<char> flip_component; ///< the sign stage's, before the global stage's
 
   bool operator()(const Swept_record& s, std::uint32_t segment, Label label) const
   {
     const std::uint32_t c = (*segment_component)[s.segment];
     const std::array<double, 3> u = unit_normal(s.record);
-    const double sign = double(label) * ((*flip_component)[c] ? -1.0 : 1.0);
+    const double sign = double(label) * (flip_component[c] ? -1.0 : 1.0);
     if (const auto* cell = grid->find(s.record.position[0], s.record.position[1], s.record.position[2]))
       for (std::uint32_t j : *cell)
         if (component[j] == c && sign * (u[0] * normal[j][0] + u[1] * normal[j][1] + u[2] * normal[j][2]) > 0.5)
@@ -152,17 +152,20 @@ std::vector<std::uint32_t> segment_patches(const std::vector<Point>& points, con
   return patch;
 }
 
-/// The global stage on the labelled records: the same search as in core
-/// (`Winding_patch_signs`) on a subsample, over three levels of patches
-/// (the final segments, then the segments cut by cells of 4 and 1.5 radii);
-/// the points then follow the samples (`Global_point_flips`, installed in
-/// `labels`).  `component` and `segment_has_unary` are per sweep segment;
-/// `flip_component` is the sign stage's decision.  Memory: the subsample,
-/// and O(segments).
+/// The global stage on the labelled records, as in core on a subsample:
+/// exterior visibility (`seen_side_flips()`) over the components and the
+/// final segments, then the winding number (`Winding_patch_signs`) over
+/// three levels of patches (the final segments, then the segments cut by
+/// cells of 4 and 1.5 radii).  Whole components negate in
+/// `flip_component` (the sign stage's decision, per component); the points
+/// follow the samples for the rest (`Global_point_flips`, installed in
+/// `labels`).  `component` and `segment_has_unary` are per sweep segment.
+/// Memory: the subsample, and O(segments).
 template <typename ConcurrencyTag>
 Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
-                                 const std::vector<std::uint32_t>& component, const std::vector<char>& flip_component,
+                                 const std::vector<std::uint32_t>& component, std::vector<char>& flip_component,
                                  const std::vector<char>& segment_has_unary, double radius, std::uint64_t n,
+                                 const Normal_orientation::internal::Global_settings& settings,
                                  const Progress_reporter& progress)
 {
   typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
@@ -180,9 +183,26 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   }
   std::vector<double> areas = estimate_point_areas<ConcurrencyTag>(samples.points, samples.normals);
   Normal_orientation::internal::cap_areas(areas);
-  Winding_patch_signs<Kernel> search;
-  search.template build<ConcurrencyTag>(samples.points, samples.normals, areas);
+  // Exterior visibility first: whole components negate in flip_component,
+  // segments through the samples.
+  const std::size_t nc = flip_component.size();
+  std::vector<char> component_fixed(nc, 0);
+  if (!labels.label_file)
+    for (std::size_t j = 0; j < ns; ++j)
+      component_fixed[samples.component[j]] |= segment_has_unary[samples.segment[j]];
+  std::vector<std::uint32_t> first;
+  const std::vector<std::uint32_t> sheet = segment_patches(samples.points, samples.segment, 0.0, first);
+  const Normal_orientation::internal::Seen_side_flips seen = Normal_orientation::internal::seen_side_flips<ConcurrencyTag>(
+    samples.points, samples.normals, areas, samples.component, sheet, nc, first.size(), component_fixed, settings);
   std::vector<char> sample_flip(ns, 0);
+  std::vector<Kernel::Vector_3> oriented(samples.normals);
+  for (std::size_t j = 0; j < ns; ++j) {
+    sample_flip[j] = seen.patch[sheet[j]];
+    if (seen.component[samples.component[j]] != sample_flip[j])
+      oriented[j] = -oriented[j];
+  }
+  Winding_patch_signs<Kernel> search;
+  search.template build<ConcurrencyTag>(samples.points, oriented, areas);
   for (double cell_radii : Normal_orientation::internal::patch_cell_radii) {
     std::vector<std::uint32_t> first;
     const std::vector<std::uint32_t> patch = segment_patches(samples.points, samples.segment, cell_radii * radius, first);
@@ -199,6 +219,21 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
       sample_flip[j] ^= flip[patch[j]];
     Normal_orientation::internal::add_level(report, level);
   }
+  // The winding number's flips that make a component face away from where
+  // it was seen are undone.
+  std::vector<char> flipped(ns);
+  std::vector<signed char> sign(ns);
+  for (std::size_t j = 0; j < ns; ++j) {
+    flipped[j] = sample_flip[j] != seen.patch[sheet[j]];
+    sign[j] = (sample_flip[j] != seen.component[samples.component[j]]) ? -1 : 1;
+  }
+  const std::vector<char> veto =
+    Normal_orientation::internal::seen_side_vetoes(seen.vote, areas, samples.component, flipped, sign, nc);
+  for (std::size_t j = 0; j < ns; ++j)
+    if (veto[samples.component[j]])
+      sample_flip[j] = seen.patch[sheet[j]];
+  for (char v : veto)
+    report.seen_vetoes += v ? 1 : 0;
   progress.report(3, 4);
   report.points_flipped = 0; // (counted in core only)
   if (std::find(sample_flip.begin(), sample_flip.end(), 1) != sample_flip.end()) {
@@ -216,11 +251,16 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
     flips->component = std::move(samples.component);
     flips->flip = std::move(sample_flip);
     flips->segment_component = &component;
-    flips->flip_component = &flip_component;
+    flips->flip_component = flip_component;
     labels.point_flip = [flips](const Swept_record& s, std::uint32_t segment, Label label) {
       return (*flips)(s, segment, label);
     };
   }
+  for (std::size_t c = 0; c < nc; ++c)
+    flip_component[c] ^= seen.component[c];
+  report.visibility = settings.orientation == Normal_orientation::Global_orientation::VISIBILITY_AND_WINDING;
+  report.seen_components_flipped = seen.components_flipped;
+  report.seen_patches_flipped = seen.patches_flipped;
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress.report(4, 4);
   return report;
