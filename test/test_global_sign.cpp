@@ -391,6 +391,14 @@ TEST(Global_sign, OpenScansFaceTheSideTheyWereSeenFrom)
   EXPECT_LE(double(orient_and_count(city, NO::Global_orientation::VISIBILITY_AND_WINDING, 24, &r)) / n, 0.05);
   EXPECT_GE(r.global.seen_components_flipped, 1u);
   EXPECT_GE(double(orient_and_count(city, NO::Global_orientation::WINDING, 24)) / n, 0.3);
+  // a bowl scanned from below: visibility alone, with +z up, would turn it
+  // inward (its inside is seen from above); the solver and the winding
+  // number outvote it
+  std::vector<Sample> bowl;
+  for (const Sample& t : NO::test::sphere(40000, g))
+    if (t.p.z() < 0.0)
+      bowl.push_back(t);
+  EXPECT_EQ(orient_and_count(bowl, NO::Global_orientation::VISIBILITY_AND_WINDING, 25), 0u);
   // the other open scans and the closed classes keep what the winding number gets
   for (const char* name : {"open_box", "single_view_scan", "hollow_ball", "bored_cylinder"}) {
     std::mt19937_64 g(1);

@@ -191,7 +191,7 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
     free_component[c] = !fixed[c];
   out.vote = exterior_visibility<ConcurrencyTag>(points, oriented, areas, settings.visibility());
   std::vector<double> vote = out.vote;
-  out.component = visibility_flips(vote, areas, sample_component, free_component);
+  out.component = visibility_flips(vote, areas, sample_component, free_component, 0.01);
   for (std::size_t j = 0; j < vote.size(); ++j) {
     free_patch[sample_patch[j]] = free_component[sample_component[j]];
     if (out.component[sample_component[j]])
@@ -205,23 +205,28 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
   return out;
 }
 
-/// The components (groups of `sample_group`) where the winding number's
-/// flips must be undone: those where it flipped samples (`flipped`) and
-/// that, with their final signs (`sign` times the input orientation of
-/// `vote`), face away from the side they were seen from (area-weighted
-/// mean vote below `-margin`).
+/// The sheets (groups of `sample_group`) where the winding number's flips
+/// are undone: where it negated samples against both the solver and
+/// exterior visibility (`against`: negated by the winding number, not by
+/// visibility), and these samples, with their final signs (`sign` times
+/// the input orientation of `vote`), face away from the side they were seen
+/// from (their area-weighted mean vote is below `-margin`).  Where
+/// visibility negated a sheet and the winding number negates it back, the
+/// solver and the winding number outvote it.
 inline std::vector<char> seen_side_vetoes(const std::vector<double>& vote, const std::vector<double>& areas,
                                           const std::vector<std::uint32_t>& sample_group,
-                                          const std::vector<char>& flipped, const std::vector<signed char>& sign,
+                                          const std::vector<char>& against, const std::vector<signed char>& sign,
                                           std::size_t number_of_groups, double margin = 0.01)
 {
   std::vector<char> eligible(number_of_groups, 0);
-  std::vector<double> final_vote(vote.size());
-  for (std::size_t j = 0; j < vote.size(); ++j) {
-    eligible[sample_group[j]] |= flipped[j];
-    final_vote[j] = double(sign[j]) * vote[j];
-  }
-  return visibility_flips(final_vote, areas, sample_group, eligible, margin);
+  std::vector<double> final_vote(vote.size(), 0.0), area(vote.size(), 0.0);
+  for (std::size_t j = 0; j < vote.size(); ++j)
+    if (against[j]) {
+      eligible[sample_group[j]] = 1;
+      final_vote[j] = double(sign[j]) * vote[j];
+      area[j] = areas[j];
+    }
+  return visibility_flips(final_vote, area, sample_group, eligible, margin);
 }
 
 /// The samples of the in-core global stage: every stride-th point of the
@@ -305,8 +310,8 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
 /// subsample: exterior visibility negates the components, then the sheets
 /// (the patches of the first level), that face away from where they were
 /// seen; the winding number then negates patches, level by level, and its
-/// flips are undone in the components they make face away from where they
-/// were seen.  Components with a point of `has_unary` keep their signs.
+/// flips against both the solver and visibility are undone in the sheets
+/// they turn away from where they were seen (`seen_side_vetoes()`).  Components with a point of `has_unary` keep their signs.
 template <typename ConcurrencyTag, typename Kernel>
 Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                                       const std::vector<typename Kernel::Vector_3>& normals,
@@ -347,17 +352,19 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   Global_sign_summary report;
   core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, component, radius, has_unary, samples, labels,
                                               report);
-  // 3. Its flips that make a component face away from where it was seen.
-  std::vector<char> flipped(ns);
+  // 3. Its flips against both the solver and visibility, in the sheets they
+  // turn away from where they were seen, are undone.
+  std::vector<char> against(ns);
   std::vector<signed char> sign(ns);
   for (std::size_t t = 0; t < ns; ++t) {
     const std::uint32_t i = samples.index[t];
-    flipped[t] = labels[i] != seen_labels[i];
+    against[t] = labels[i] != seen_labels[i] && seen_labels[i] == labels_before[i];
     sign[t] = labels[i] == labels_before[i] ? 1 : -1;
   }
-  const std::vector<char> veto = seen_side_vetoes(seen.vote, samples.areas, samples.component, flipped, sign, nc);
+  const std::vector<char> veto = seen_side_vetoes(seen.vote, samples.areas, sample_sheet, against, sign,
+                                                  number_of_sheets);
   for (std::size_t i = 0; i < n; ++i)
-    if (veto[component[i]])
+    if (veto[sheet[i]] && labels[i] != seen_labels[i] && seen_labels[i] == labels_before[i])
       labels[i] = seen_labels[i];
   report.visibility = settings.orientation == Global_orientation::VISIBILITY_AND_WINDING;
   report.seen_components_flipped = seen.components_flipped;

@@ -219,18 +219,19 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
       sample_flip[j] ^= flip[patch[j]];
     Normal_orientation::internal::add_level(report, level);
   }
-  // The winding number's flips that make a component face away from where
-  // it was seen are undone.
-  std::vector<char> flipped(ns);
+  // The winding number's flips against both the solver and visibility, in
+  // the segments they turn away from where they were seen, are undone.
+  std::vector<char> against(ns);
   std::vector<signed char> sign(ns);
   for (std::size_t j = 0; j < ns; ++j) {
-    flipped[j] = sample_flip[j] != seen.patch[sheet[j]];
+    const bool seen_flip = seen.component[samples.component[j]] != seen.patch[sheet[j]];
+    against[j] = sample_flip[j] != seen.patch[sheet[j]] && !seen_flip;
     sign[j] = (sample_flip[j] != seen.component[samples.component[j]]) ? -1 : 1;
   }
   const std::vector<char> veto =
-    Normal_orientation::internal::seen_side_vetoes(seen.vote, areas, samples.component, flipped, sign, nc);
+    Normal_orientation::internal::seen_side_vetoes(seen.vote, areas, sheet, against, sign, first.size());
   for (std::size_t j = 0; j < ns; ++j)
-    if (veto[samples.component[j]])
+    if (veto[sheet[j]] && against[j])
       sample_flip[j] = seen.patch[sheet[j]];
   for (char v : veto)
     report.seen_vetoes += v ? 1 : 0;
