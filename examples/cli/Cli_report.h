@@ -80,6 +80,8 @@ inline void json_global(Json_writer& j, const Normal_orientation::Global_sign_su
   j.key("closed_components").integer(g.closed_components).key("open_components").integer(g.open_components);
   j.key("rounds").integer(g.rounds);
   j.key("energy_before").number(g.energy_before).key("energy_after").number(g.energy_after);
+  j.key("coherence").number(g.coherence).key("coarse_points").integer(g.coarse_points);
+  j.key("coarse_used").boolean(g.coarse_used);
   j.key("seconds").fixed(g.seconds);
   j.end_object();
 }

@@ -12,6 +12,7 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Orientation_result.h>
 #include <Normal_orientation/Progress.h>
+#include <Normal_orientation/internal/Core_coarse_scale.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/internal/Settings.h>
 #include <Normal_orientation/internal/Unit_vector.h>
@@ -447,6 +448,25 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(graph, in.points, in.normals, component,
                                                                             gr.radius, has_unary, labels);
         result.seconds.global = result.global.seconds;
+        // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
+        {
+          const internal::Coarse_scale_report coarse = internal::core_coarse_signs<ConcurrencyTag, Kernel>(
+            in.points, in.normals, gr.radius, labels, result.global.closedness, [&](auto& cloud) {
+              return orient_normals<ConcurrencyTag>(cloud, parameters::point_map(internal::Coarse_point_map<Kernel>())
+                                                      .normal_map(internal::Coarse_normal_map<Kernel>())
+                                                      .geom_traits(Kernel())
+                                                      .flip_criterion(criterion)
+                                                      .solver(solver)
+                                                      .global_orientation(Global_orientation::WINDING)
+                                                      .random_seed(settings.random_seed)
+                                                      .number_of_threads(settings.number_of_threads)).global.closedness;
+            });
+          result.global.coherence = coarse.coherence;
+          result.global.coarse_points = coarse.coarse_points;
+          result.global.coarse_used = coarse.used;
+          result.global.seconds += coarse.seconds;
+          result.seconds.global += coarse.seconds;
+        }
       }
       result.energy_after = energy(graph, weight, label_map);
       for (std::size_t q = 0; q < n; ++q)
