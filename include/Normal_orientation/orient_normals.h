@@ -449,17 +449,12 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
                                                                             gr.radius, has_unary, labels);
         result.seconds.global = result.global.seconds;
         // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
-        {
+        if constexpr (!has_constraints && !has_prior) {
           const internal::Coarse_scale_report coarse = internal::core_coarse_signs<ConcurrencyTag, Kernel>(
             in.points, in.normals, gr.radius, labels, result.global.closedness, [&](auto& cloud) {
-              return orient_normals<ConcurrencyTag>(cloud, parameters::point_map(internal::Coarse_point_map<Kernel>())
-                                                      .normal_map(internal::Coarse_normal_map<Kernel>())
-                                                      .geom_traits(Kernel())
-                                                      .flip_criterion(criterion)
-                                                      .solver(solver)
-                                                      .global_orientation(Global_orientation::WINDING)
-                                                      .random_seed(settings.random_seed)
-                                                      .number_of_threads(settings.number_of_threads)).global.closedness;
+              return orient_normals<ConcurrencyTag>(
+                       cloud, internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings))
+                .global.closedness;
             });
           result.global.coherence = coarse.coherence;
           result.global.coarse_points = coarse.coarse_points;

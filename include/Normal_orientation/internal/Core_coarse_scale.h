@@ -8,10 +8,12 @@
 /// the accumulator from the vectors of the in-core pipeline, has the coarse
 /// cloud oriented by the caller and gives every point the coarse sign.
 
+#include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/internal/Coarse_scale.h>
 #include <Normal_orientation/internal/Parallel.h>
 #include <Normal_orientation/internal/Settings.h>
+#include <Normal_orientation/parameters.h>
 
 #include <CGAL/number_utils.h>
 
@@ -67,6 +69,21 @@ template <typename PointRange>
 struct Is_coarse_cloud : std::false_type {};
 template <typename Kernel>
 struct Is_coarse_cloud<std::vector<Coarse_cloud_point<Kernel>>> : std::true_type {};
+
+/// The named parameters with which both drivers orient a coarse cloud: the
+/// run's flip criterion, solver, seed and threads, and the global stage.
+template <typename Kernel, typename FlipCriterion, typename Solver>
+auto coarse_cloud_parameters(const FlipCriterion& criterion, const Solver& solver, const Settings& settings)
+{
+  return parameters::point_map(Coarse_point_map<Kernel>())
+    .normal_map(Coarse_normal_map<Kernel>())
+    .geom_traits(Kernel())
+    .flip_criterion(criterion)
+    .solver(solver)
+    .global_orientation(Global_orientation::WINDING)
+    .random_seed((unsigned int)(settings.random_seed))
+    .number_of_threads(settings.number_of_threads);
+}
 
 /// Builds the coarse cloud of `coarse` as the in-core pipeline takes it.
 template <typename Kernel>
