@@ -23,7 +23,6 @@
 #include <chrono>
 #include <cstdint>
 #include <limits>
-#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -31,8 +30,7 @@ namespace Normal_orientation {
 /// \cond SKIP_IN_MANUAL
 namespace internal {
 
-/// A point of the coarse cloud as the in-core pipeline orients it; a type of
-/// its own, so that the pipeline knows not to run the coarse pass on it.
+/// A point of the coarse cloud as the in-core pipeline orients it.
 template <typename Kernel>
 struct Coarse_cloud_point
 {
@@ -62,13 +60,6 @@ struct Coarse_normal_map
   friend reference get(const Coarse_normal_map&, const key_type& k) { return k.normal; }
   friend void put(const Coarse_normal_map&, key_type& k, const value_type& v) { k.normal = v; }
 };
-
-/// Whether `PointRange` is a coarse cloud (whose orientation must not start
-/// another coarse pass).
-template <typename PointRange>
-struct Is_coarse_cloud : std::false_type {};
-template <typename Kernel>
-struct Is_coarse_cloud<std::vector<Coarse_cloud_point<Kernel>>> : std::true_type {};
 
 /// The named parameters with which both drivers orient a coarse cloud: the
 /// run's flip criterion, solver, seed and threads, and the global stage.
