@@ -10,6 +10,8 @@
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/orient_normals.h>
 
+#include <CGAL/pca_estimate_normals.h>
+
 #include "Hard_shapes.h"
 #include "Synthetic_shapes.h"
 
@@ -434,4 +436,106 @@ TEST(Global_sign, HardShapesOfTheFailureClasses)
       EXPECT_GE(before, c.before) << c.name;
     }
   }
+}
+
+namespace {
+
+/// `n` points on a torus of radii `R` and `r` (area-uniform), outward normals
+std::vector<Sample> torus(std::size_t n, double R, double r, std::mt19937_64& rng)
+{
+  std::uniform_real_distribution<double> u(0.0, 2.0 * M_PI), w(0.0, 1.0);
+  std::vector<Sample> s;
+  while (s.size() < n) {
+    const double a = u(rng), b = u(rng);
+    if (w(rng) * (R + r) > R + r * std::cos(b)) // the area element is (R + r cos b) da db
+      continue;
+    const Vector normal(std::cos(a) * std::cos(b), std::sin(a) * std::cos(b), std::sin(b));
+    s.push_back({Point((R + r * std::cos(b)) * std::cos(a), (R + r * std::cos(b)) * std::sin(a), r * std::sin(b)),
+                 normal});
+  }
+  return s;
+}
+
+/// `truth` with Gaussian position noise of deviation `sigma`, PCA normals
+/// over 18 neighbours and random signs
+std::vector<Point_with_normal> noisy_cloud(const std::vector<Sample>& truth, double sigma, unsigned seed)
+{
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<Point_with_normal> cloud;
+  for (const Sample& s : truth)
+    cloud.emplace_back(Point(s.p.x() + sigma * g(rng), s.p.y() + sigma * g(rng), s.p.z() + sigma * g(rng)),
+                       Vector(0, 0, 1));
+  CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
+    cloud, 18,
+    CGAL::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
+      .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>()));
+  for (Point_with_normal& p : cloud)
+    if (rng() & 1)
+      p.second = -p.second;
+  return cloud;
+}
+
+/// the share of wrong normals among those whose line is within 60 degrees of the truth
+double clear_wrong(const std::vector<Point_with_normal>& cloud, const std::vector<Sample>& truth)
+{
+  std::size_t clear = 0, wrong = 0;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const double c = cloud[i].second * truth[i].n / std::sqrt(cloud[i].second.squared_length());
+    if (std::abs(c) >= 0.5) {
+      ++clear;
+      wrong += c <= 0.0;
+    }
+  }
+  return clear > 0 ? double(wrong) / double(clear) : 0.0;
+}
+
+} // namespace
+
+TEST(Coarse_scale, NoiseWiderThanTheSpacingIsOrientedAtACoarserScale)
+{
+  // 100k points on a torus of radii 1 and 0.1 (area 3.9): a spacing of about
+  // 0.0063, noise of deviation 0.02, a sixth of the tube's diameter.  The input
+  // normals do not agree; without the global stage about 46% of the clear
+  // normals are wrong (the fine pipeline with the stage but without the
+  // coarse pass gets no better: it is less closed than the coarse one).
+  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
+                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  std::mt19937_64 rng(31);
+  const std::vector<Sample> truth = torus(100000, 1.0, 0.1, rng);
+  std::vector<Point_with_normal> cloud = noisy_cloud(truth, 0.02, 32);
+  std::vector<Point_with_normal> without = cloud;
+  const NO::Orientation_result r = NO::orient_normals(cloud, np);
+  NO::orient_normals(without, np.global_orientation(NO::Global_orientation::NONE));
+  const double after = clear_wrong(cloud, truth), before = clear_wrong(without, truth);
+  std::printf("noisy torus: coherence %.3f, %zu coarse points; clear normals wrong: %.2f%% without the "
+              "global stage, %.2f%% with it\n",
+              r.global.coherence, r.global.coarse_points, 100.0 * before, 100.0 * after);
+  EXPECT_LT(r.global.coherence, NO::internal::coarse_coherence_threshold);
+  EXPECT_TRUE(r.global.coarse_used);
+  EXPECT_LE(after, 0.02);
+  EXPECT_GE(before, 0.2);
+  // only signs change
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    EXPECT_TRUE(cloud[i].second == without[i].second || cloud[i].second == -without[i].second);
+}
+
+TEST(Coarse_scale, CleanCloudsAreLeftToTheFinePipeline)
+{
+  // The same torus without noise, and the hollow ball: the normals agree, the
+  // coarse pass does not run.
+  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
+                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  std::mt19937_64 rng(31);
+  const std::vector<Sample> truth = torus(100000, 1.0, 0.1, rng);
+  std::vector<Point_with_normal> cloud = noisy_cloud(truth, 0.0, 32);
+  NO::Orientation_result r = NO::orient_normals(cloud, np);
+  EXPECT_GE(r.global.coherence, NO::internal::coarse_coherence_threshold);
+  EXPECT_EQ(r.global.coarse_points, 0u);
+  EXPECT_FALSE(r.global.coarse_used);
+  EXPECT_EQ(clear_wrong(cloud, truth), 0.0);
+  const std::vector<Sample> s = hollow_ball(20000, rng);
+  EXPECT_EQ(orient_and_count(s, NO::Global_orientation::WINDING, 1, &r), 0u);
+  EXPECT_GE(r.global.coherence, NO::internal::coarse_coherence_threshold);
+  EXPECT_EQ(r.global.coarse_points, 0u);
 }

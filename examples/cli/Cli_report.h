@@ -85,6 +85,8 @@ inline void json_global(Json_writer& j, const Normal_orientation::Global_sign_su
   j.key("seen_components_flipped").integer(g.seen_components_flipped);
   j.key("seen_patches_flipped").integer(g.seen_patches_flipped).key("seen_vetoes").integer(g.seen_vetoes);
   j.key("energy_before").number(g.energy_before).key("energy_after").number(g.energy_after);
+  j.key("coherence").number(g.coherence).key("coarse_points").integer(g.coarse_points);
+  j.key("coarse_used").boolean(g.coarse_used);
   j.key("seconds").fixed(g.seconds);
   j.end_object();
 }

@@ -36,6 +36,14 @@ struct Global_sign_summary
   double energy_before = std::numeric_limits<double>::quiet_NaN(); ///< sum a_j (w_j - 1/2)^2 before the stage
   double energy_after = std::numeric_limits<double>::quiet_NaN();  ///< the same after it
   double seconds = 0.0;                ///< the stage's wall-clock time
+  /// the coarse-to-fine pass (noise wider than the spacing): the median
+  /// coherence of the input normals in cells of about two spacings (1 when
+  /// parallel, 1/3 when isotropic; NaN when not measured), the points of the
+  /// coarse cloud (0 when the normals agreed), and whether the points took
+  /// its signs
+  double coherence = std::numeric_limits<double>::quiet_NaN();
+  std::size_t coarse_points = 0;       ///< see `coherence`
+  bool coarse_used = false;            ///< see `coherence`
 };
 
 /// \ingroup PkgNormalOrientationRef

@@ -12,6 +12,7 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Orientation_result.h>
 #include <Normal_orientation/Progress.h>
+#include <Normal_orientation/internal/Core_coarse_scale.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/internal/Settings.h>
 #include <Normal_orientation/internal/Unit_vector.h>
@@ -461,6 +462,20 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
                                                                             gr.radius, has_unary, policies.global,
                                                                             labels);
         result.seconds.global = result.global.seconds;
+        // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
+        if constexpr (!has_constraints && !has_prior) {
+          const internal::Coarse_scale_report coarse = internal::core_coarse_signs<ConcurrencyTag, Kernel>(
+            in.points, in.normals, gr.radius, labels, result.global.closedness, [&](auto& cloud) {
+              return orient_normals<ConcurrencyTag>(
+                       cloud, internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, policies.global))
+                .global.closedness;
+            });
+          result.global.coherence = coarse.coherence;
+          result.global.coarse_points = coarse.coarse_points;
+          result.global.coarse_used = coarse.used;
+          result.global.seconds += coarse.seconds;
+          result.seconds.global += coarse.seconds;
+        }
       }
       result.energy_after = energy(graph, weight, label_map);
       for (std::size_t q = 0; q < n; ++q)

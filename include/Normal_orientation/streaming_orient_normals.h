@@ -23,6 +23,8 @@
 #include <Normal_orientation/internal/Settings.h>
 #include <Normal_orientation/parameters.h>
 #include <Normal_orientation/solvers/Qpbo_i_solver.h>
+#include <Normal_orientation/internal/Core_coarse_scale.h>
+#include <Normal_orientation/streaming/Coarse_stage.h>
 #include <Normal_orientation/streaming/Component_files.h>
 #include <Normal_orientation/streaming/Labelled_records.h>
 #include <Normal_orientation/streaming/Output_stage.h>
@@ -267,6 +269,23 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     t = Clock::now();
     result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component,
                                                  swept.segment_has_unary, radius, n, global, stage(Stage::GLOBAL));
+    // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
+    if constexpr (!Unary::enabled) {
+      const auto coarse = coarse_stage(
+        points, labels, solution.component, flip_component, radius, n, result.global.closedness,
+        [&](const Normal_orientation::internal::Coarse_scale& c) {
+          auto cloud = Normal_orientation::internal::make_coarse_cloud<Kernel>(c);
+          const double closedness =
+            orient_normals<ConcurrencyTag>(
+              cloud, Normal_orientation::internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, global))
+              .global.closedness;
+          return std::make_pair(Normal_orientation::internal::coarse_cloud_normals(cloud), closedness);
+        });
+      result.global.coherence = coarse.coherence;
+      result.global.coarse_points = coarse.coarse_points;
+      result.global.coarse_used = coarse.used;
+      result.global.seconds += coarse.seconds;
+    }
     result.seconds.global = seconds_since(t);
     if (labels.point_flip) // (point by point: the energy of the output is not measured)
       result.energy_after = std::numeric_limits<double>::quiet_NaN();
