@@ -301,7 +301,7 @@ TEST(Exterior_visibility, VotesOfAClosedSurfaceAndOfASheet)
   const std::vector<Sample> ball = NO::test::sphere(4000, rng);
   std::vector<double> areas;
   // outward normals face every view that sees them (a few samples at the
-  // bottom, seen only from below and at a graze, may be hidden in all 64)
+  // bottom, seen only from below and at a graze, may be hidden in all 32)
   std::vector<double> out = visibility_votes(ball, 1.0, areas), in = visibility_votes(ball, -1.0, areas);
   std::size_t unseen = 0;
   for (std::size_t j = 0; j < ball.size(); ++j) {

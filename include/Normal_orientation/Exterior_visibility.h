@@ -30,7 +30,7 @@ namespace Normal_orientation {
 struct Exterior_visibility_options
 {
   /// views, spread evenly over the sphere of directions (a Fibonacci sphere)
-  unsigned int number_of_directions = 64;
+  unsigned int number_of_directions = 32;
   /// the up direction of the scene (need not be unit; zero: none, every
   /// view weighs 1)
   std::array<double, 3> up = {{0.0, 0.0, 1.0}};
