@@ -41,6 +41,13 @@ namespace {
 
 typedef std::pair<Point, Vector> Point_with_normal;
 
+/// the named parameters of a vector of Point_with_normal
+auto pwn_params()
+{
+  return NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
+    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+}
+
 /// orient_normals with the given global stage; returns the wrong count
 std::size_t orient_and_count(const std::vector<Sample>& truth, NO::Global_orientation global, unsigned seed,
                              NO::Orientation_result* result = nullptr)
@@ -48,9 +55,7 @@ std::size_t orient_and_count(const std::vector<Sample>& truth, NO::Global_orient
   std::mt19937_64 rng(seed);
   std::vector<Point_with_normal> cloud = NO::test::unoriented(truth, rng);
   const NO::Orientation_result r =
-    NO::orient_normals(cloud, NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
-                                .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>())
-                                .global_orientation(global));
+    NO::orient_normals(cloud, pwn_params().global_orientation(global));
   if (result)
     *result = r;
   return NO::test::count_wrong(truth, cloud);
@@ -232,8 +237,7 @@ TEST(Global_sign, DefaultIsWindingUnlessTheUserSaysWhichSide)
   std::mt19937_64 rng(14);
   const std::vector<Sample> s = hollow_ball(6000, rng);
   std::vector<Point_with_normal> cloud = NO::test::unoriented(s, rng);
-  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
-                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  const auto np = pwn_params();
   const NO::Orientation_result r = NO::orient_normals(cloud, np);
   EXPECT_TRUE(r.global.ran);
   EXPECT_TRUE(r.global.visibility);
@@ -250,8 +254,7 @@ TEST(Global_sign, SameOutputForOneAndTwoThreads)
   const std::vector<Sample> s = touching_spheres(12000, rng);
   std::mt19937_64 r1(9), r2(9);
   std::vector<Point_with_normal> a = NO::test::unoriented(s, r1), b = NO::test::unoriented(s, r2);
-  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
-                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  const auto np = pwn_params();
   NO::orient_normals(a, np.number_of_threads(1));
   NO::orient_normals(b, np.number_of_threads(2));
   EXPECT_TRUE(a == b);
@@ -355,8 +358,7 @@ TEST(Exterior_visibility, BadInputThrows)
   EXPECT_THROW(NO::visibility_flips({0.1, -0.1}, a, {0, 2}, {1, 1}), std::invalid_argument);
   EXPECT_EQ(NO::visibility_flips({0.1, -0.1}, a, {0, 1}, {1, 1}), (std::vector<char>{0, 1}));
   EXPECT_EQ(NO::visibility_flips({0.1, -0.1}, a, {0, 1}, {1, 0}), (std::vector<char>{0, 0}));
-  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
-                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  const auto np = pwn_params();
   std::vector<Point_with_normal> cloud = {{Point(0, 0, 0), Vector(0, 0, 1)}, {Point(1, 0, 0), Vector(0, 0, 1)}};
   EXPECT_THROW(NO::orient_normals(cloud, np.up_direction(Vector(0, std::nan(""), 1))), std::invalid_argument);
 }
@@ -377,8 +379,7 @@ TEST(Global_sign, OpenScansFaceTheSideTheyWereSeenFrom)
   std::vector<Point_with_normal> given;
   for (const Sample& t : tile)
     given.emplace_back(t.p, t.n);
-  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
-                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  const auto np = pwn_params();
   EXPECT_TRUE(NO::orient_normals(given, np).global.visibility); // the default
   EXPECT_LE(double(NO::test::count_wrong(tile, given)) / n, 0.01);
   // the same tile with +y up: right when the up direction says so
@@ -499,8 +500,7 @@ TEST(Coarse_scale, NoiseWiderThanTheSpacingIsOrientedAtACoarserScale)
   // normals do not agree; without the global stage about 46% of the clear
   // normals are wrong (the fine pipeline with the stage but without the
   // coarse pass gets no better: it is less closed than the coarse one).
-  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
-                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  const auto np = pwn_params();
   std::mt19937_64 rng(31);
   const std::vector<Sample> truth = torus(100000, 1.0, 0.1, rng);
   std::vector<Point_with_normal> cloud = noisy_cloud(truth, 0.02, 32);
@@ -524,8 +524,7 @@ TEST(Coarse_scale, CleanCloudsAreLeftToTheFinePipeline)
 {
   // The same torus without noise, and the hollow ball: the normals agree, the
   // coarse pass does not run.
-  const auto np = NO::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
-                    .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
+  const auto np = pwn_params();
   std::mt19937_64 rng(31);
   const std::vector<Sample> truth = torus(100000, 1.0, 0.1, rng);
   std::vector<Point_with_normal> cloud = noisy_cloud(truth, 0.0, 32);

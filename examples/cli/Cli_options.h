@@ -154,6 +154,18 @@ T parse_number(const std::string& option, const std::string& text)
   return value;
 }
 
+/// `text` read whole as "X,Y,Z" of finite numbers into `xyz`, or a
+/// `Usage_error` naming `option`
+inline void parse_triple(const std::string& option, std::string text, double* xyz)
+{
+  for (char& c : text)
+    if (c == ',')
+      c = ' ';
+  std::istringstream in(text);
+  if (!(in >> xyz[0] >> xyz[1] >> xyz[2]) || !(in >> std::ws).eof() || !std::isfinite(xyz[0] + xyz[1] + xyz[2]))
+    throw Usage_error(option + " needs X,Y,Z");
+}
+
 /// reads option `a` (at argv[i]) into `o`, with `value()` its value;
 /// returns false when `a` is not an option (a positional argument)
 template <typename Value>
@@ -194,23 +206,9 @@ bool read_option(Options& o, const std::string& a, const Value& value)
     if (o.global != "auto" && o.global != "visibility" && o.global != "winding" && o.global != "none")
       throw Usage_error("unknown global stage '" + o.global + "' (auto, visibility, winding, none)");
   } else if (a == "--up") {
-    std::string v = value();
-    for (char& c : v)
-      if (c == ',')
-        c = ' ';
-    std::istringstream in(v);
-    if (!(in >> o.up[0] >> o.up[1] >> o.up[2]) || !(in >> std::ws).eof() ||
-        !std::isfinite(o.up[0] + o.up[1] + o.up[2]))
-      throw Usage_error("--up needs X,Y,Z");
+    parse_triple(a, value(), o.up.data());
   } else if (a == "--viewpoint") {
-    std::string v = value();
-    for (char& c : v)
-      if (c == ',')
-        c = ' ';
-    std::istringstream in(v);
-    if (!(in >> o.viewpoint[0] >> o.viewpoint[1] >> o.viewpoint[2]) || !(in >> std::ws).eof() ||
-        !std::isfinite(o.viewpoint[0] + o.viewpoint[1] + o.viewpoint[2]))
-      throw Usage_error("--viewpoint needs X,Y,Z");
+    parse_triple(a, value(), o.viewpoint);
     o.has_viewpoint = true;
   } else if (a == "--prior-weight") {
     o.prior_weight = parse_number<double>(a, value());

@@ -272,20 +272,25 @@ Core_samples<Kernel> core_samples(const std::vector<typename Kernel::Point_3>& p
 
 /// The winding number's levels of patches (`patch_cell_radii`) on the
 /// in-core arrays: flips `labels` and adds the figures to `report`.
+/// `sheets` (`number_of_sheets` of them) are the first level's patches when
+/// `labels` has not changed since they were built, else empty.
 template <typename ConcurrencyTag, typename Kernel>
 void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                          const std::vector<typename Kernel::Vector_3>& normals,
                          const std::vector<std::uint32_t>& component, double radius,
                          const std::vector<char>& has_unary, const Core_samples<Kernel>& samples,
+                         const std::vector<std::uint32_t>& sheets, std::size_t number_of_sheets,
                          std::vector<Label>& labels, Global_sign_summary& report)
 {
   const std::size_t n = points.size();
   Winding_patch_signs<Kernel> search;
   search.template build<ConcurrencyTag>(samples.points, samples.oriented, samples.areas);
   for (double cell_radii : patch_cell_radii) {
-    std::size_t np = 0;
+    const bool reuse = cell_radii == 0.0 && !sheets.empty();
+    std::size_t np = reuse ? number_of_sheets : 0;
     const std::vector<std::uint32_t> patch =
-      build_patches<Kernel>(graph, points, normals, labels, cell_radii * radius, samples.is_sample, np);
+      reuse ? sheets
+            : build_patches<Kernel>(graph, points, normals, labels, cell_radii * radius, samples.is_sample, np);
     std::vector<std::uint32_t> spatch;
     for (std::uint32_t i : samples.index)
       spatch.push_back(patch[i]);
@@ -350,8 +355,11 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   const std::vector<Label> seen_labels = labels;
   // 2. The winding number.
   Global_sign_summary report;
-  core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, component, radius, has_unary, samples, labels,
-                                              report);
+  // (visibility flipped nothing: the sheets are the winding number's first level)
+  const bool unchanged = seen.components_flipped == 0 && seen.patches_flipped == 0;
+  core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, component, radius, has_unary, samples,
+                                              unchanged ? sheet : std::vector<std::uint32_t>(), number_of_sheets,
+                                              labels, report);
   // 3. Its flips against both the solver and visibility, in the sheets they
   // turn away from where they were seen, are undone.
   std::vector<char> against(ns);

@@ -190,10 +190,11 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   if (!labels.label_file)
     for (std::size_t j = 0; j < ns; ++j)
       component_fixed[samples.component[j]] |= segment_has_unary[samples.segment[j]];
-  std::vector<std::uint32_t> first;
-  const std::vector<std::uint32_t> sheet = segment_patches(samples.points, samples.segment, 0.0, first);
+  std::vector<std::uint32_t> sheet_first;
+  const std::vector<std::uint32_t> sheet = segment_patches(samples.points, samples.segment, 0.0, sheet_first);
   const Normal_orientation::internal::Seen_side_flips seen = Normal_orientation::internal::seen_side_flips<ConcurrencyTag>(
-    samples.points, samples.normals, areas, samples.component, sheet, nc, first.size(), component_fixed, settings);
+    samples.points, samples.normals, areas, samples.component, sheet, nc, sheet_first.size(), component_fixed,
+    settings);
   std::vector<char> sample_flip(ns, 0);
   std::vector<Kernel::Vector_3> oriented(samples.normals);
   for (std::size_t j = 0; j < ns; ++j) {
@@ -204,8 +205,10 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   Winding_patch_signs<Kernel> search;
   search.template build<ConcurrencyTag>(samples.points, oriented, areas);
   for (double cell_radii : Normal_orientation::internal::patch_cell_radii) {
-    std::vector<std::uint32_t> first;
-    const std::vector<std::uint32_t> patch = segment_patches(samples.points, samples.segment, cell_radii * radius, first);
+    std::vector<std::uint32_t> cut_first; // (the first level is the sheets: segments do not change)
+    const std::vector<std::uint32_t> patch =
+      cell_radii == 0.0 ? sheet : segment_patches(samples.points, samples.segment, cell_radii * radius, cut_first);
+    const std::vector<std::uint32_t>& first = cell_radii == 0.0 ? sheet_first : cut_first;
     std::vector<std::uint32_t> patch_component(first.size());
     std::vector<char> fixed(first.size(), 0);
     for (std::size_t P = 0; P < first.size(); ++P)
@@ -229,7 +232,7 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
     sign[j] = (sample_flip[j] != seen.component[samples.component[j]]) ? -1 : 1;
   }
   const std::vector<char> veto =
-    Normal_orientation::internal::seen_side_vetoes(seen.vote, areas, sheet, against, sign, first.size());
+    Normal_orientation::internal::seen_side_vetoes(seen.vote, areas, sheet, against, sign, sheet_first.size());
   for (std::size_t j = 0; j < ns; ++j)
     if (veto[sheet[j]] && against[j])
       sample_flip[j] = seen.patch[sheet[j]];
