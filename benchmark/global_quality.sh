@@ -3,7 +3,7 @@
 # This file is part of Normal_orientation.
 #
 # global_quality.sh BUILD_DIR [--sizes "4000 30000 200000 1000000"] [--noise "0 0.002 0.005"]
-#                   [--meshes DIR_OR_FILES] [--clouds DIR] [--ipsr IPSR_BINARY] [--out FILE.md]
+#                   [--meshes DIR_OR_FILES] [--clouds DIR] [--stream] [--ipsr IPSR_BINARY] [--out FILE.md]
 #                   [--seed S] [--timeout S] [--ipsr-timeout S] [--ipsr-max-points N] [--keep DIR]
 #
 # The quality table of issue 15 (item 7): wrong normals of our orientation before and after the
@@ -22,6 +22,8 @@ usage: global_quality.sh BUILD_DIR [options]
                           (default /work/shared/data/meshes)
   --clouds DIR            score pre-made clouds instead: pairs DIR/NAME.xyz + DIR/NAME.gt.xyz
                           (--sizes, --noise and --meshes are then ignored)
+  --stream                add the column of ours streamed (orient_normals --stream --keep-order,
+                          the defaults otherwise), to compare the two drivers on the same clouds
   --ipsr IPSR_BINARY      add the iPSR column (benchmark/ipsr/build_ipsr.sh builds it)
   --out FILE.md           also write the table to FILE.md
   --seed S                make_cloud seed (default 1)
@@ -55,7 +57,13 @@ run_timeout=600
 ipsr_timeout=300
 ipsr_max_points=300000
 keep=""
+stream=0
 while [[ $# -gt 0 ]]; do
+  if [[ $1 == --stream ]]; then
+    stream=1
+    shift
+    continue
+  fi
   [[ $# -ge 2 ]] || { echo "global_quality.sh: $1 needs a value" >&2; usage; }
   case $1 in
     --sizes) sizes=${2//,/ } ;;
@@ -109,9 +117,11 @@ else
   trap 'rm -rf "$work"' EXIT
 fi
 
-columns=(before after cgal)
+columns=(before after)
+[[ $stream -eq 0 ]] || columns+=(stream)
+columns+=(cgal)
 [[ -n "$ipsr" ]] && columns+=(ipsr)
-declare -A title=([before]="ours, before" [after]="ours, after" [cgal]="CGAL" [ipsr]="iPSR")
+declare -A title=([before]="ours, before" [after]="ours, after" [stream]="ours, --stream" [cgal]="CGAL" [ipsr]="iPSR")
 # Results, keyed by "ROW,COLUMN": cell status (ok, FAILED, timeout, skipped) and counts.
 declare -A status points wrong clear clear_wrong seconds
 rows=()          # row keys, in order
@@ -173,6 +183,10 @@ orient_row() {
   else
     run_cell "$row" after "$run_timeout" "$prefix.xyz" "$prefix.gt.xyz" "$work/$row.after.xyz" \
       "$ours" --quiet "$prefix.xyz" "$work/$row.after.xyz"
+  fi
+  if [[ $stream -eq 1 ]]; then
+    run_cell "$row" stream "$run_timeout" "$prefix.xyz" "$prefix.gt.xyz" "$work/$row.stream.xyz" \
+      "$ours" --quiet --stream --keep-order "$prefix.xyz" "$work/$row.stream.xyz"
   fi
   run_cell "$row" cgal "$run_timeout" "$prefix.xyz" "$prefix.gt.xyz" "$work/$row.cgal.xyz" \
     "$cgal" --quiet "$prefix.xyz" "$work/$row.cgal.xyz"
@@ -277,6 +291,7 @@ report() {
   echo "- command: \`$command_line\`"
   echo "- source: commit $(git -C "$script_dir" log -1 --format='%h (%cs)' 2>/dev/null || echo unknown)"
   echo "- ours, before: $before_note; ours, after: \`orient_normals\`; CGAL: \`cgal_mst_orient\` (k = 18)"
+  [[ $stream -eq 0 ]] || echo "- ours, --stream: \`orient_normals --stream --keep-order\` (the streaming driver, its defaults otherwise)"
   [[ -z "$ipsr" ]] || echo "- iPSR: \`$ipsr\`, default settings, signs from the closest triangle of its mesh (\`ipsr/ipsr_orient.sh\`)"
   echo "- cells: wrong normals in % of all normals (\"all\") and of the clear normals, whose line is within 60° of the truth (\"60°\"); times: whole process, in seconds"
   echo
