@@ -205,25 +205,31 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
   return out;
 }
 
+/// Whether the winding number negated a sample against both the solver and
+/// exterior visibility: it negated it (`by_winding`), visibility did not
+/// (`by_visibility`).
+inline bool negated_against_both(char by_visibility, char by_winding) { return by_winding && !by_visibility; }
+
 /// The sheets (groups of `sample_group`) where the winding number's flips
 /// are undone: where it negated samples against both the solver and
-/// exterior visibility (`against`: negated by the winding number, not by
-/// visibility), and these samples, with their final signs (`sign` times
-/// the input orientation of `vote`), face away from the side they were seen
-/// from (their area-weighted mean vote is below `-margin`).  Where
-/// visibility negated a sheet and the winding number negates it back, the
-/// solver and the winding number outvote it.
+/// exterior visibility (`negated_against_both()`; per sample, whether
+/// visibility negated it, `by_visibility`, and whether the winding number
+/// negated it after that, `by_winding`), and these samples, with their
+/// final signs, face away from the side they were seen from (their
+/// area-weighted mean `vote`, of their input orientation, is below
+/// `-margin`).  Where visibility negated a sheet and the winding number
+/// negates it back, the solver and the winding number outvote it.
 inline std::vector<char> seen_side_vetoes(const std::vector<double>& vote, const std::vector<double>& areas,
                                           const std::vector<std::uint32_t>& sample_group,
-                                          const std::vector<char>& against, const std::vector<signed char>& sign,
+                                          const std::vector<char>& by_visibility, const std::vector<char>& by_winding,
                                           std::size_t number_of_groups, double margin = 0.01)
 {
   std::vector<char> eligible(number_of_groups, 0);
   std::vector<double> final_vote(vote.size(), 0.0), area(vote.size(), 0.0);
   for (std::size_t j = 0; j < vote.size(); ++j)
-    if (against[j]) {
+    if (negated_against_both(by_visibility[j], by_winding[j])) {
       eligible[sample_group[j]] = 1;
-      final_vote[j] = double(sign[j]) * vote[j];
+      final_vote[j] = (by_visibility[j] != by_winding[j] ? -1.0 : 1.0) * vote[j];
       area[j] = areas[j];
     }
   return visibility_flips(final_vote, area, sample_group, eligible, margin);
@@ -362,17 +368,17 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
                                               labels, report);
   // 3. Its flips against both the solver and visibility, in the sheets they
   // turn away from where they were seen, are undone.
-  std::vector<char> against(ns);
-  std::vector<signed char> sign(ns);
+  auto by_visibility = [&](std::size_t i) { return char(seen_labels[i] != labels_before[i]); };
+  auto by_winding = [&](std::size_t i) { return char(labels[i] != seen_labels[i]); };
+  std::vector<char> sample_by_visibility(ns), sample_by_winding(ns);
   for (std::size_t t = 0; t < ns; ++t) {
-    const std::uint32_t i = samples.index[t];
-    against[t] = labels[i] != seen_labels[i] && seen_labels[i] == labels_before[i];
-    sign[t] = labels[i] == labels_before[i] ? 1 : -1;
+    sample_by_visibility[t] = by_visibility(samples.index[t]);
+    sample_by_winding[t] = by_winding(samples.index[t]);
   }
-  const std::vector<char> veto = seen_side_vetoes(seen.vote, samples.areas, sample_sheet, against, sign,
-                                                  number_of_sheets);
+  const std::vector<char> veto = seen_side_vetoes(seen.vote, samples.areas, sample_sheet, sample_by_visibility,
+                                                  sample_by_winding, number_of_sheets);
   for (std::size_t i = 0; i < n; ++i)
-    if (veto[sheet[i]] && labels[i] != seen_labels[i] && seen_labels[i] == labels_before[i])
+    if (veto[sheet[i]] && negated_against_both(by_visibility(i), by_winding(i)))
       labels[i] = seen_labels[i];
   report.visibility = settings.orientation == Global_orientation::VISIBILITY_AND_WINDING;
   report.seen_components_flipped = seen.components_flipped;

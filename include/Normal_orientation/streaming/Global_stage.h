@@ -224,17 +224,15 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   }
   // The winding number's flips against both the solver and visibility, in
   // the segments they turn away from where they were seen, are undone.
-  std::vector<char> against(ns);
-  std::vector<signed char> sign(ns);
+  std::vector<char> by_visibility(ns), by_winding(ns);
   for (std::size_t j = 0; j < ns; ++j) {
-    const bool seen_flip = seen.component[samples.component[j]] != seen.patch[sheet[j]];
-    against[j] = sample_flip[j] != seen.patch[sheet[j]] && !seen_flip;
-    sign[j] = (sample_flip[j] != seen.component[samples.component[j]]) ? -1 : 1;
+    by_visibility[j] = seen.component[samples.component[j]] != seen.patch[sheet[j]];
+    by_winding[j] = sample_flip[j] != seen.patch[sheet[j]];
   }
-  const std::vector<char> veto =
-    Normal_orientation::internal::seen_side_vetoes(seen.vote, areas, sheet, against, sign, sheet_first.size());
+  const std::vector<char> veto = Normal_orientation::internal::seen_side_vetoes(
+    seen.vote, areas, sheet, by_visibility, by_winding, sheet_first.size());
   for (std::size_t j = 0; j < ns; ++j)
-    if (veto[sheet[j]] && against[j])
+    if (veto[sheet[j]] && Normal_orientation::internal::negated_against_both(by_visibility[j], by_winding[j]))
       sample_flip[j] = seen.patch[sheet[j]];
   for (char v : veto)
     report.seen_vetoes += v ? 1 : 0;
