@@ -34,36 +34,87 @@ namespace internal {
 /// coarse levels move whole sheets at once.
 constexpr double patch_cell_radii[] = {0.0, 4.0, 1.5};
 
-/// Whether the edge (i, j) joins two points of one smooth sheet that the
-/// solver oriented consistently: the oriented normals agree within 60
-/// degrees and the edge lies within 60 degrees of both tangent planes.
+/// The slope of the edge (i, j) against the normals `mi`, `mj` of its ends:
+/// the larger |cos| of its angles with them (0: it lies in both tangent
+/// planes), or 1 when the edge or a normal is zero.
 template <typename Point, typename Vector>
-bool same_sheet(const Point& pi, const Point& pj, const Vector& mi, const Vector& mj)
+double edge_slope(const Point& pi, const Point& pj, const Vector& mi, const Vector& mj)
 {
   const double d[3] = {CGAL::to_double(pj.x() - pi.x()), CGAL::to_double(pj.y() - pi.y()),
                        CGAL::to_double(pj.z() - pi.z())};
   const double len = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
   const double a[3] = {CGAL::to_double(mi.x()), CGAL::to_double(mi.y()), CGAL::to_double(mi.z())};
   const double b[3] = {CGAL::to_double(mj.x()), CGAL::to_double(mj.y()), CGAL::to_double(mj.z())};
-  const double ab = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-  if (!(ab >= 0.5))
-    return false;
-  if (!(len > 0.0))
-    return true;
-  const double da = (d[0] * a[0] + d[1] * a[1] + d[2] * a[2]) / len;
-  const double db = (d[0] * b[0] + d[1] * b[1] + d[2] * b[2]) / len;
-  return std::abs(da) <= 0.5 && std::abs(db) <= 0.5;
+  const double la = std::sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+  const double lb = std::sqrt(b[0] * b[0] + b[1] * b[1] + b[2] * b[2]);
+  if (!(len > 0.0) || !(la > 0.0) || !(lb > 0.0))
+    return 1.0;
+  const double da = std::abs(d[0] * a[0] + d[1] * a[1] + d[2] * a[2]) / (len * la);
+  const double db = std::abs(d[0] * b[0] + d[1] * b[1] + d[2] * b[2]) / (len * lb);
+  return std::min(1.0, std::max(da, db));
+}
+
+/// The largest edge slope (`edge_slopes()`) of the sheets of exterior
+/// visibility and of the seen-side vetoes: 30 degrees from both tangent planes.
+constexpr double sheet_slope = 0.5;
+
+/// The smallest edge slope of the winding number's patches (`patch_slope()`):
+/// about 8.6 degrees from both tangent planes.
+constexpr double patch_slope_floor = 0.15;
+
+/// `edge_slope()` of every edge of `graph`, in the order of `edges(graph)`,
+/// with the unoriented normals.
+template <typename Kernel>
+std::vector<float> edge_slopes(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
+                               const std::vector<typename Kernel::Vector_3>& normals)
+{
+  std::vector<float> slope;
+  slope.reserve(num_edges(graph));
+  typename boost::graph_traits<Neighbor_graph>::edge_iterator it, end;
+  for (boost::tie(it, end) = edges(graph); it != end; ++it) {
+    const std::size_t i = source(*it, graph), j = target(*it, graph);
+    slope.push_back(float(edge_slope(points[i], points[j], normals[i], normals[j])));
+  }
+  return slope;
+}
+
+/// The largest edge slope of the winding number's patches: the median of
+/// `slopes` (every 16th of them), within [`patch_slope_floor`,
+/// `sheet_slope`].  On a clean cloud the patches end where the surface bends
+/// by more than about 8.6 degrees over one edge (thin parts, contacts
+/// between objects, features that the spacing under-samples); noise steepens
+/// every edge, and the median keeps at least half of them.
+inline double patch_slope(const std::vector<float>& slopes)
+{
+  std::vector<float> some;
+  for (std::size_t e = 0; e < slopes.size(); e += 16)
+    some.push_back(slopes[e]);
+  if (some.empty())
+    return sheet_slope;
+  std::nth_element(some.begin(), some.begin() + std::ptrdiff_t(some.size() / 2), some.end());
+  return std::min(sheet_slope, std::max(patch_slope_floor, double(some[some.size() / 2])));
+}
+
+/// Whether an edge joins two points of one smooth sheet that the solver
+/// oriented consistently: the oriented normals `mi`, `mj` of its ends agree
+/// within 60 degrees and its slope (`edge_slopes()`) is at most `max_slope`.
+template <typename Vector>
+bool same_sheet(const Vector& mi, const Vector& mj, float slope, double max_slope)
+{
+  return CGAL::to_double(mi * mj) >= 0.5 && double(slope) <= max_slope;
 }
 
 /// Patches of the labelled cloud, numbered 0, 1, ... by their first point:
-/// the points joined by `same_sheet` edges within one cell of side
-/// `cell` (0: anywhere); then patches without a sample join a
-/// neighbouring patch through an edge whose oriented normals agree.
+/// the points joined by `same_sheet` edges (`slopes` from `edge_slopes()`,
+/// at most `max_slope`) within one cell of side `cell` (0: anywhere); then
+/// patches without a sample join a neighbouring patch through an edge whose
+/// oriented normals agree.
 /// Returns the patch of every point (zero normals get a patch of their own).
 template <typename Kernel>
 std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                                          const std::vector<typename Kernel::Vector_3>& normals,
                                          const std::vector<Label>& labels, double cell,
+                                         const std::vector<float>& slopes, double max_slope,
                                          const std::vector<char>& is_sample, std::size_t& number_of_patches)
 {
   const std::size_t n = points.size();
@@ -81,9 +132,10 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std:
   auto oriented = [&](std::size_t i) { return labels[i] < 0 ? -normals[i] : normals[i]; };
   Signed_union_find uf(n);
   typename boost::graph_traits<Neighbor_graph>::edge_iterator it, end;
-  for (boost::tie(it, end) = edges(graph); it != end; ++it) {
+  std::size_t e = 0;
+  for (boost::tie(it, end) = edges(graph); it != end; ++it, ++e) {
     const std::size_t i = source(*it, graph), j = target(*it, graph);
-    if (cells[i] == cells[j] && same_sheet(points[i], points[j], oriented(i), oriented(j)))
+    if (cells[i] == cells[j] && same_sheet(oriented(i), oriented(j), slopes[e], max_slope))
       uf.unite(Signed_union_find::Index(i), Signed_union_find::Index(j));
   }
   // Patches without a sample join a sampled neighbour (a few sweeps reach
@@ -276,13 +328,15 @@ Core_samples<Kernel> core_samples(const std::vector<typename Kernel::Point_3>& p
   return s;
 }
 
-/// The winding number's levels of patches (`patch_cell_radii`) on the
-/// in-core arrays: flips `labels` and adds the figures to `report`.
-/// `sheets` (`number_of_sheets` of them) are the first level's patches when
-/// `labels` has not changed since they were built, else empty.
+/// The winding number's levels of patches (`patch_cell_radii`, edges of
+/// slope at most `patch_slope()` of `slopes`) on the in-core arrays: flips
+/// `labels` and adds the figures to `report`.  `sheets` (`number_of_sheets`
+/// of them, of slope at most `sheet_slope`) are the first level's patches
+/// when `labels` has not changed since they were built and the slopes agree,
+/// else empty.
 template <typename ConcurrencyTag, typename Kernel>
 void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
-                         const std::vector<typename Kernel::Vector_3>& normals,
+                         const std::vector<typename Kernel::Vector_3>& normals, const std::vector<float>& slopes,
                          const std::vector<std::uint32_t>& component, double radius,
                          const std::vector<char>& has_unary, const Core_samples<Kernel>& samples,
                          const std::vector<std::uint32_t>& sheets, std::size_t number_of_sheets,
@@ -291,12 +345,14 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
   const std::size_t n = points.size();
   Winding_patch_signs<Kernel> search;
   search.template build<ConcurrencyTag>(samples.points, samples.oriented, samples.areas);
+  const double slope = patch_slope(slopes);
   for (double cell_radii : patch_cell_radii) {
-    const bool reuse = cell_radii == 0.0 && !sheets.empty();
+    const bool reuse = cell_radii == 0.0 && !sheets.empty() && slope == sheet_slope;
     std::size_t np = reuse ? number_of_sheets : 0;
     const std::vector<std::uint32_t> patch =
       reuse ? sheets
-            : build_patches<Kernel>(graph, points, normals, labels, cell_radii * radius, samples.is_sample, np);
+            : build_patches<Kernel>(graph, points, normals, labels, cell_radii * radius, slopes, slope,
+                                    samples.is_sample, np);
     std::vector<std::uint32_t> spatch;
     for (std::uint32_t i : samples.index)
       spatch.push_back(patch[i]);
@@ -342,10 +398,12 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   for (std::size_t i = 0; i < has_unary.size(); ++i)
     if (has_unary[i])
       component_fixed[component[i]] = 1;
+  const std::vector<float> slopes = edge_slopes<Kernel>(graph, points, normals);
   // 1. Exterior visibility.
   std::size_t number_of_sheets = 0;
   const std::vector<std::uint32_t> sheet =
-    build_patches<Kernel>(graph, points, normals, labels, 0.0, samples.is_sample, number_of_sheets);
+    build_patches<Kernel>(graph, points, normals, labels, 0.0, slopes, sheet_slope, samples.is_sample,
+                          number_of_sheets);
   std::vector<std::uint32_t> sample_sheet(ns);
   for (std::size_t t = 0; t < ns; ++t)
     sample_sheet[t] = sheet[samples.index[t]];
@@ -363,9 +421,9 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   Global_sign_summary report;
   // (visibility flipped nothing: the sheets are the winding number's first level)
   const bool unchanged = seen.components_flipped == 0 && seen.patches_flipped == 0;
-  core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, component, radius, has_unary, samples,
-                                              unchanged ? sheet : std::vector<std::uint32_t>(), number_of_sheets,
-                                              labels, report);
+  core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, slopes, component, radius, has_unary,
+                                              samples, unchanged ? sheet : std::vector<std::uint32_t>(),
+                                              number_of_sheets, labels, report);
   // 3. Its flips against both the solver and visibility, in the sheets they
   // turn away from where they were seen, are undone.
   auto by_visibility = [&](std::size_t i) { return char(seen_labels[i] != labels_before[i]); };
