@@ -561,17 +561,11 @@ void two_layers(std::size_t n, double h, double gap, std::vector<Point>& points,
       }
 }
 
-/// the median edge slope of `graph` over all its edges
-double median_slope(const NO::Neighbor_graph& graph, const std::vector<Point>& points,
-                    const std::vector<Vector>& normals)
+/// the median of all the edge slopes `slopes` (of `edge_slopes()`)
+double median_slope(std::vector<float> slopes)
 {
-  std::vector<double> slope;
-  for (auto e : boost::make_iterator_range(edges(graph))) {
-    const std::size_t i = source(e, graph), j = target(e, graph);
-    slope.push_back(NO::internal::edge_slope(points[i], points[j], normals[i], normals[j]));
-  }
-  std::sort(slope.begin(), slope.end());
-  return slope[slope.size() / 2];
+  std::sort(slopes.begin(), slopes.end());
+  return double(slopes[slopes.size() / 2]);
 }
 
 } // namespace
@@ -624,8 +618,9 @@ TEST(Global_sign, PatchSlopeIsTheMedianEdgeSlopeWithinItsBounds)
     }
     NO::Neighbor_graph graph;
     NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(points, normals, 12, 0.0, NO::Hoppe_criterion(), graph);
-    const double median = median_slope(graph, points, normals);
-    const double slope = NO::internal::patch_slope(NO::internal::edge_slopes<Kernel>(graph, points, normals));
+    const std::vector<float> slopes = NO::internal::edge_slopes<Kernel>(graph, points, normals);
+    const double median = median_slope(slopes);
+    const double slope = NO::internal::patch_slope(slopes);
     std::printf("torus, noise %.3f: median edge slope %.3f, patch slope %.3f\n", sigma, median, slope);
     EXPECT_NEAR(slope,
                 std::min(NO::internal::sheet_slope, std::max(NO::internal::patch_slope_floor, median)), 0.02);
