@@ -366,7 +366,7 @@ check "no output for --keep-order into another format" test ! -e "$dir/kept.ply"
 # the global sign stage: on by default, reported in the JSON; --global none turns it off
 expect_exit 0 "default: global stage in the json" "$prog" --quiet --json "$dir/sphere.xyz" "$dir/g_default.xyz"
 check "json has a global object with a closedness" grep -q '"global": {"stage": "visibility", "closedness": ' "$dir/out.txt"
-check "json reports the seen side" grep -q '"seen_components_flipped": [0-9]*, "seen_patches_flipped": [0-9]*, "seen_vetoes": ' "$dir/out.txt"
+check "json reports the seen side" grep -q '"seen_components_flipped": [0-9]*, "seen_patches_flipped": [0-9]*, "seen_vetoes": [0-9]*, "top_components_flipped": ' "$dir/out.txt"
 expect_exit 0 "--global winding" "$prog" --quiet --json --global winding "$dir/sphere.xyz" "$dir/g_winding.xyz"
 check "json global stage is winding with --global winding" grep -q '"global": {"stage": "winding"' "$dir/out.txt"
 expect_exit 0 "--up 0,1,0" "$prog" --quiet --json --up 0,1,0 "$dir/sphere.xyz" "$dir/g_up.xyz"

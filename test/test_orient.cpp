@@ -12,6 +12,7 @@
 
 #include <CGAL/Polygon_mesh_processing/IO/polygon_mesh_io.h>
 #include <CGAL/Point_set_3.h>
+#include <CGAL/pca_estimate_normals.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/property_map.h>
 
@@ -876,6 +877,34 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
     EXPECT_TRUE(sr.global.ran) << c.name;
     EXPECT_LE(double(streamed) / n, c.streamed) << c.name;
     EXPECT_LE(double(core) / n, c.core) << c.name;
+  }
+  // A street between two facades with PCA normals (one sheet across the
+  // rounded creases): its ground faces up, streamed as in core, and so do
+  // the facades that the solver ties to it.
+  {
+    std::mt19937_64 g(41);
+    const auto truth = NO::hard_shapes::street_canyon(20000, g);
+    auto input = unoriented(truth, g);
+    CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
+      input, 18,
+      CGAL::parameters::point_map(CGAL::First_of_pair_property_map<std::pair<Point, Vector>>())
+        .normal_map(CGAL::Second_of_pair_property_map<std::pair<Point, Vector>>()));
+    Rewindable_source src{as_records(input)};
+    std::vector<NO::Point_record> out;
+    auto sink = [&](const NO::Point_record& r) { out.push_back(r); };
+    const NO::Streaming_result sr = NO::streaming_orient_normals(src, sink);
+    ASSERT_EQ(out.size(), input.size());
+    std::size_t streamed = 0;
+    for (const auto& r : out)
+      streamed += (Vector(r.normal[0], r.normal[1], r.normal[2]) * truth[r.index].n <= 0.0) ? 1 : 0;
+    auto in_core = input;
+    const auto rc = NO::orient_normals(in_core, pn_params());
+    const double n = double(input.size());
+    std::printf("street_canyon (PCA)  wrong streamed %6.2f%%, in core %6.2f%%\n", 100.0 * double(streamed) / n,
+                100.0 * double(count_wrong(truth, in_core)) / n);
+    EXPECT_LE(double(streamed) / n, 0.02);
+    EXPECT_LE(double(count_wrong(truth, in_core)) / n, 0.01);
+    EXPECT_GE(sr.global.top_components_flipped + rc.global.top_components_flipped, 1u);
   }
   // an explicit none runs no stage
   std::mt19937_64 rng(2);

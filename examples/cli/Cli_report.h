@@ -60,12 +60,14 @@ inline void print_global(const Normal_orientation::Global_sign_summary& g)
   if (g.ran)
     std::fprintf(stderr,
                  "global stage (%s): %zu patch%s, %zu flipped; closedness %.3f, %zu closed and %zu open "
-                 "component%s; seen side: %zu component%s and %zu sheet%s flipped, %zu veto%s; %.3f s\n",
+                 "component%s; seen side: %zu component%s and %zu sheet%s flipped, %zu veto%s; top side: %zu "
+                 "component%s flipped; %.3f s\n",
                  g.visibility ? "visibility, winding" : "winding", g.number_of_patches,
                  g.number_of_patches == 1 ? "" : "es", g.patches_flipped, g.closedness, g.closed_components,
                  g.open_components, plural(g.open_components), g.seen_components_flipped,
                  plural(g.seen_components_flipped), g.seen_patches_flipped, plural(g.seen_patches_flipped),
-                 g.seen_vetoes, g.seen_vetoes == 1 ? "" : "es", g.seconds);
+                 g.seen_vetoes, g.seen_vetoes == 1 ? "" : "es", g.top_components_flipped,
+                 plural(g.top_components_flipped), g.seconds);
 }
 
 /// "global": what the global sign stage saw and did (null when it did not run)
@@ -84,6 +86,7 @@ inline void json_global(Json_writer& j, const Normal_orientation::Global_sign_su
   j.key("rounds").integer(g.rounds);
   j.key("seen_components_flipped").integer(g.seen_components_flipped);
   j.key("seen_patches_flipped").integer(g.seen_patches_flipped).key("seen_vetoes").integer(g.seen_vetoes);
+  j.key("top_components_flipped").integer(g.top_components_flipped);
   j.key("energy_before").number(g.energy_before).key("energy_after").number(g.energy_after);
   j.key("coherence").number(g.coherence).key("coarse_points").integer(g.coarse_points);
   j.key("coarse_used").boolean(g.coarse_used);

@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace Normal_orientation {
@@ -116,6 +117,41 @@ void add_view(const std::vector<Point>& points, const std::vector<Vector>& norma
   }
 }
 
+/// The splats' radii of `exterior_visibility()`, after checking its input;
+/// `caller` names the function in the exceptions.
+template <typename Point, typename Vector>
+std::vector<double> splat_radii(const std::vector<Point>& points, const std::vector<Vector>& normals,
+                                const std::vector<double>& areas, const Exterior_visibility_options& options,
+                                const char* caller)
+{
+  const std::size_t n = points.size();
+  auto fail = [caller](const char* what) { throw std::invalid_argument(std::string(caller) + ": " + what); };
+  if (normals.size() != n || areas.size() != n)
+    fail("points, normals and areas differ in size");
+  if (options.number_of_directions == 0 || options.maximum_resolution == 0 || !(options.splat_factor > 0.0) ||
+      !(options.below_horizon_weight >= 0.0) || !std::isfinite(options.splat_factor) ||
+      !std::isfinite(options.below_horizon_weight) || !std::isfinite(options.up[0]) ||
+      !std::isfinite(options.up[1]) || !std::isfinite(options.up[2]))
+    fail("an option is out of range");
+  std::vector<double> radius(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    if (!std::isfinite(points[j].x()) || !std::isfinite(points[j].y()) || !std::isfinite(points[j].z()))
+      fail("a position is not finite");
+    if (!(areas[j] >= 0.0) || !std::isfinite(areas[j]))
+      fail("an area is negative or not finite");
+    radius[j] = options.splat_factor * std::sqrt(areas[j] / 3.141592653589793);
+  }
+  return radius;
+}
+
+/// The median of `radius` (not empty), at least the smallest positive double:
+/// the pixel side of the views.
+inline double median_radius(std::vector<double> radius)
+{
+  std::nth_element(radius.begin(), radius.begin() + std::ptrdiff_t(radius.size() / 2), radius.end());
+  return std::max(radius[radius.size() / 2], std::numeric_limits<double>::min());
+}
+
 } // namespace internal
 /// \endcond
 
@@ -148,27 +184,11 @@ std::vector<double> exterior_visibility(const std::vector<Point>& points, const 
                                         const Exterior_visibility_options& options = {})
 {
   const std::size_t n = points.size();
-  if (normals.size() != n || areas.size() != n)
-    throw std::invalid_argument("exterior_visibility: points, normals and areas differ in size");
-  if (options.number_of_directions == 0 || options.maximum_resolution == 0 || !(options.splat_factor > 0.0) ||
-      !(options.below_horizon_weight >= 0.0) || !std::isfinite(options.splat_factor) ||
-      !std::isfinite(options.below_horizon_weight) || !std::isfinite(options.up[0]) ||
-      !std::isfinite(options.up[1]) || !std::isfinite(options.up[2]))
-    throw std::invalid_argument("exterior_visibility: an option is out of range");
-  std::vector<double> radius(n);
-  for (std::size_t j = 0; j < n; ++j) {
-    if (!std::isfinite(points[j].x()) || !std::isfinite(points[j].y()) || !std::isfinite(points[j].z()))
-      throw std::invalid_argument("exterior_visibility: a position is not finite");
-    if (!(areas[j] >= 0.0) || !std::isfinite(areas[j]))
-      throw std::invalid_argument("exterior_visibility: an area is negative or not finite");
-    radius[j] = options.splat_factor * std::sqrt(areas[j] / 3.141592653589793);
-  }
+  const std::vector<double> radius = internal::splat_radii(points, normals, areas, options, "exterior_visibility");
   std::vector<double> vote(n, 0.0);
   if (n == 0)
     return vote;
-  std::vector<double> sorted(radius);
-  std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(n / 2), sorted.end());
-  const double cell = std::max(sorted[n / 2], std::numeric_limits<double>::min());
+  const double cell = internal::median_radius(radius);
   // Fixed blocks of directions, summed in order: the same votes for any
   // thread count.
   const unsigned int count = options.number_of_directions, blocks = std::min(8u, count);
@@ -198,6 +218,64 @@ std::vector<double> exterior_visibility(const std::vector<Point>& points, const 
   for (double& x : vote)
     x /= total_weight;
   return vote;
+}
+
+/// \ingroup PkgNormalOrientationGlobal
+/// For every sample, how much its oriented normal faces up where it is on
+/// the top surface of the scene: n . u (n and u = `options.up` made unit)
+/// where no splat hides the sample in the orthographic view from straight
+/// above (the splats and the hiding rule of `exterior_visibility()`), 0
+/// where one does, and 0 for every sample when `options.up` is zero.
+/// Outside a closed surface, the top surface faces up everywhere; so does
+/// the ground of a scene seen from above or from the ground.
+///
+/// \tparam ConcurrencyTag `CGAL::Sequential_tag` or `CGAL::Parallel_tag`
+/// \throws std::invalid_argument as `exterior_visibility()`
+template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag, typename Point, typename Vector>
+std::vector<double> top_view_facing(const std::vector<Point>& points, const std::vector<Vector>& normals,
+                                    const std::vector<double>& areas, const Exterior_visibility_options& options = {})
+{
+  const std::vector<double> radius = internal::splat_radii(points, normals, areas, options, "top_view_facing");
+  std::vector<double> facing(points.size(), 0.0);
+  const double lu = std::sqrt(options.up[0] * options.up[0] + options.up[1] * options.up[1] + options.up[2] * options.up[2]);
+  if (points.empty() || !(lu > 0.0) || !std::isfinite(lu))
+    return facing;
+  const std::array<double, 3> u = {{options.up[0] / lu, options.up[1] / lu, options.up[2] / lu}};
+  internal::add_view(points, normals, radius, u, 1.0, internal::median_radius(radius), options.maximum_resolution,
+                     facing);
+  return facing;
+}
+
+/// \ingroup PkgNormalOrientationGlobal
+/// The groups of samples (components) whose top surface faces down: those
+/// with a flag in `eligible` (per group id) where the samples of the top
+/// surface that lie within 30 degrees of horizontal (|`facing`| >= cos 30
+/// degrees, `facing` from `top_view_facing()`) hold at least
+/// `minimum_fraction` of the group's area and face down on more than
+/// three quarters of that area.  `group` is the group id of each sample;
+/// the result has a flag per group id.
+/// \throws std::invalid_argument when the sizes differ or an id is out of range
+inline std::vector<char> downward_top_flips(const std::vector<double>& facing, const std::vector<double>& areas,
+                                            const std::vector<std::uint32_t>& group,
+                                            const std::vector<char>& eligible, double minimum_fraction = 0.05)
+{
+  if (areas.size() != facing.size() || group.size() != facing.size())
+    throw std::invalid_argument("downward_top_flips: facings, areas and groups differ in size");
+  std::vector<double> area(eligible.size(), 0.0), top(eligible.size(), 0.0), down(eligible.size(), 0.0);
+  for (std::size_t j = 0; j < facing.size(); ++j) {
+    if (group[j] >= eligible.size())
+      throw std::invalid_argument("downward_top_flips: a group id is out of range");
+    area[group[j]] += areas[j];
+    if (std::abs(facing[j]) >= 0.8660254037844386) {
+      top[group[j]] += areas[j];
+      if (facing[j] < 0.0)
+        down[group[j]] += areas[j];
+    }
+  }
+  std::vector<char> flip(eligible.size(), 0);
+  for (std::size_t g = 0; g < eligible.size(); ++g)
+    flip[g] = eligible[g] && area[g] > 0.0 && top[g] >= minimum_fraction * area[g] && down[g] > 0.75 * top[g];
+  return flip;
 }
 
 /// \ingroup PkgNormalOrientationGlobal

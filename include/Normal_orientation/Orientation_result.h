@@ -29,6 +29,7 @@ struct Global_sign_summary
   std::size_t seen_components_flipped = 0; ///< components negated to face the side they were seen from
   std::size_t seen_patches_flipped = 0;    ///< sheets (in core) or segments (streamed) negated so, after their components
   std::size_t seen_vetoes = 0;             ///< sheets (streamed: segments) where the winding number's flips against both the solver and visibility were undone
+  std::size_t top_components_flipped = 0;  ///< components negated last because their top surface faced down (`top_side_flips()`)
   unsigned int rounds = 0;             ///< rounds of patch flips
   /// the fraction of the sampled area where w is within the tolerance of
   /// 1/2, after the stage: near 1 on closed surfaces, low on open scans

@@ -328,7 +328,8 @@ Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, Weig
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{up_direction}
 ///     \cgalParamDescription{the scene's up direction for exterior visibility: views from below weigh
-///       less; a zero vector gives no side a preference}
+///       less, and a component whose top surface faces down is negated last
+///       (`downward_top_flips()`); a zero vector gives no side a preference and turns that rule off}
 ///     \cgalParamType{`Kernel::Vector_3`}
 ///     \cgalParamDefault{`Kernel::Vector_3(0, 0, 1)`}
 ///   \cgalParamNEnd

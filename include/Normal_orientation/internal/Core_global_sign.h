@@ -257,6 +257,28 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
   return out;
 }
 
+/// The components (ids below `number_of_components`, those of `fixed` left
+/// out) whose top surface faces down (`downward_top_flips()` of
+/// `top_view_facing()` of the samples, with their final oriented normals);
+/// nothing unless `settings` asks for visibility.  A closed surface's top
+/// faces up, and so does the ground of a scene seen from above or from the
+/// ground: this undoes the winding number where it takes a scene open to
+/// the sky (a street between facades) for part of a closed surface.
+template <typename ConcurrencyTag, typename Point, typename Vector>
+std::vector<char> top_side_flips(const std::vector<Point>& points, const std::vector<Vector>& oriented,
+                                 const std::vector<double>& areas, const std::vector<std::uint32_t>& sample_component,
+                                 std::size_t number_of_components, const std::vector<char>& fixed,
+                                 const Global_settings& settings)
+{
+  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
+    return std::vector<char>(number_of_components, 0);
+  std::vector<char> eligible(number_of_components, 1);
+  for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
+    eligible[c] = !fixed[c];
+  return downward_top_flips(top_view_facing<ConcurrencyTag>(points, oriented, areas, settings.visibility()), areas,
+                            sample_component, eligible);
+}
+
 /// Whether the winding number negated a sample against both the solver and
 /// exterior visibility: it negated it (`by_winding`), visibility did not
 /// (`by_visibility`).
@@ -438,6 +460,16 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   for (std::size_t i = 0; i < n; ++i)
     if (veto[sheet[i]] && negated_against_both(by_visibility(i), by_winding(i)))
       labels[i] = seen_labels[i];
+  // 4. Components whose top surface faces down are negated.
+  for (std::size_t t = 0; t < ns; ++t)
+    samples.oriented[t] = labels[samples.index[t]] < 0 ? -normals[samples.index[t]] : normals[samples.index[t]];
+  const std::vector<char> top = top_side_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
+                                                               samples.component, nc, component_fixed, settings);
+  for (std::size_t i = 0; i < n; ++i)
+    if (top[component[i]])
+      labels[i] = Label(-labels[i]);
+  for (char f : top)
+    report.top_components_flipped += f ? 1 : 0;
   report.visibility = settings.orientation == Global_orientation::VISIBILITY_AND_WINDING;
   report.seen_components_flipped = seen.components_flipped;
   report.seen_patches_flipped = seen.patches_flipped;

@@ -236,6 +236,13 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
       sample_flip[j] = seen.patch[sheet[j]];
   for (char v : veto)
     report.seen_vetoes += v ? 1 : 0;
+  // Components whose top surface faces down are negated.
+  for (std::size_t j = 0; j < ns; ++j)
+    oriented[j] = seen.component[samples.component[j]] != sample_flip[j] ? -samples.normals[j] : samples.normals[j];
+  const std::vector<char> top = Normal_orientation::internal::top_side_flips<ConcurrencyTag>(
+    samples.points, oriented, areas, samples.component, nc, component_fixed, settings);
+  for (char f : top)
+    report.top_components_flipped += f ? 1 : 0;
   progress.report(3, 4);
   report.points_flipped = 0; // (counted in core only)
   if (std::find(sample_flip.begin(), sample_flip.end(), 1) != sample_flip.end()) {
@@ -259,7 +266,7 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
     };
   }
   for (std::size_t c = 0; c < nc; ++c)
-    flip_component[c] ^= seen.component[c];
+    flip_component[c] ^= char(seen.component[c] != top[c]);
   report.visibility = settings.orientation == Normal_orientation::Global_orientation::VISIBILITY_AND_WINDING;
   report.seen_components_flipped = seen.components_flipped;
   report.seen_patches_flipped = seen.patches_flipped;
