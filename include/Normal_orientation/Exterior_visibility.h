@@ -144,6 +144,19 @@ std::vector<double> splat_radii(const std::vector<Point>& points, const std::vec
   return radius;
 }
 
+/// Checks the per-sample input of the group rules: `areas` and `group` have
+/// `n` entries and every group id is below `number_of_groups`; `caller`
+/// names the function in the exceptions.
+inline void check_groups(std::size_t n, const std::vector<double>& areas, const std::vector<std::uint32_t>& group,
+                         std::size_t number_of_groups, const char* caller)
+{
+  if (areas.size() != n || group.size() != n)
+    throw std::invalid_argument(std::string(caller) + ": per-sample values, areas and groups differ in size");
+  for (std::uint32_t g : group)
+    if (g >= number_of_groups)
+      throw std::invalid_argument(std::string(caller) + ": a group id is out of range");
+}
+
 /// The median of `radius` (not empty), at least the smallest positive double:
 /// the pixel side of the views.
 inline double median_radius(std::vector<double> radius)
@@ -259,12 +272,9 @@ inline std::vector<char> downward_top_flips(const std::vector<double>& facing, c
                                             const std::vector<std::uint32_t>& group,
                                             const std::vector<char>& eligible, double minimum_fraction = 0.05)
 {
-  if (areas.size() != facing.size() || group.size() != facing.size())
-    throw std::invalid_argument("downward_top_flips: facings, areas and groups differ in size");
+  internal::check_groups(facing.size(), areas, group, eligible.size(), "downward_top_flips");
   std::vector<double> area(eligible.size(), 0.0), top(eligible.size(), 0.0), down(eligible.size(), 0.0);
   for (std::size_t j = 0; j < facing.size(); ++j) {
-    if (group[j] >= eligible.size())
-      throw std::invalid_argument("downward_top_flips: a group id is out of range");
     area[group[j]] += areas[j];
     if (std::abs(facing[j]) >= 0.8660254037844386) {
       top[group[j]] += areas[j];
@@ -289,12 +299,9 @@ inline std::vector<char> visibility_flips(const std::vector<double>& vote, const
                                           const std::vector<std::uint32_t>& group,
                                           const std::vector<char>& eligible, double margin = 0.02)
 {
-  if (areas.size() != vote.size() || group.size() != vote.size())
-    throw std::invalid_argument("visibility_flips: votes, areas and groups differ in size");
+  internal::check_groups(vote.size(), areas, group, eligible.size(), "visibility_flips");
   std::vector<double> sum(eligible.size(), 0.0), area(eligible.size(), 0.0);
   for (std::size_t j = 0; j < vote.size(); ++j) {
-    if (group[j] >= eligible.size())
-      throw std::invalid_argument("visibility_flips: a group id is out of range");
     sum[group[j]] += areas[j] * vote[j];
     area[group[j]] += areas[j];
   }
