@@ -10,6 +10,7 @@
 /// from them (`visibility_flips()`).
 
 #include <Normal_orientation/internal/Parallel.h>
+#include <Normal_orientation/internal/Unit_vector.h>
 
 #include <CGAL/Kernel_traits.h>
 #include <CGAL/tags.h>
@@ -250,10 +251,9 @@ std::vector<double> top_view_facing(const std::vector<Point>& points, const std:
 {
   const std::vector<double> radius = internal::splat_radii(points, normals, areas, options, "top_view_facing");
   std::vector<double> facing(points.size(), 0.0);
-  const double lu = std::sqrt(options.up[0] * options.up[0] + options.up[1] * options.up[1] + options.up[2] * options.up[2]);
-  if (points.empty() || !(lu > 0.0) || !std::isfinite(lu))
+  const std::array<double, 3> u = internal::unit_vector(options.up[0], options.up[1], options.up[2]);
+  if (points.empty() || (u[0] == 0.0 && u[1] == 0.0 && u[2] == 0.0))
     return facing;
-  const std::array<double, 3> u = {{options.up[0] / lu, options.up[1] / lu, options.up[2] / lu}};
   internal::add_view(points, normals, radius, u, 1.0, internal::median_radius(radius), options.maximum_resolution,
                      facing);
   return facing;
