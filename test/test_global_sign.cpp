@@ -680,13 +680,25 @@ TEST(Global_sign, PatchesSeparateLayersCloserThanTheSpacing)
   const std::vector<float> slopes = NO::internal::edge_slopes<Kernel>(graph, points, normals);
   std::size_t sheets = 0, patches = 0;
   const std::vector<std::uint32_t> sheet = NO::internal::build_patches<Kernel>(
-    graph, points, normals, labels, 0.0, slopes, NO::internal::sheet_slope, is_sample, sheets);
+    graph, points, normals, labels, {}, 0.0, slopes, NO::internal::sheet_slope, is_sample, sheets);
   const std::vector<std::uint32_t> patch = NO::internal::build_patches<Kernel>(
-    graph, points, normals, labels, 0.0, slopes, NO::internal::patch_slope_floor, is_sample, patches);
+    graph, points, normals, labels, {}, 0.0, slopes, NO::internal::patch_slope_floor, is_sample, patches);
   EXPECT_EQ(sheets, 1u);
   EXPECT_EQ(patches, 2u);
   for (std::size_t i = 0; i < points.size(); ++i)
     EXPECT_EQ(patch[i], patch[points[i].z() == 0.0 ? 0 : points.size() - 1]) << i;
+  // Where the solver negated one layer against its start and kept the other,
+  // even the sheets part them.
+  ASSERT_EQ(points[0].z(), 0.0);
+  std::vector<char> moved(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    moved[i] = points[i].z() != 0.0;
+  std::size_t parted = 0;
+  const std::vector<std::uint32_t> apart = NO::internal::build_patches<Kernel>(
+    graph, points, normals, labels, moved, 0.0, slopes, NO::internal::sheet_slope, is_sample, parted);
+  EXPECT_EQ(parted, 2u);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    EXPECT_EQ(apart[i] == apart[0], !moved[i]) << i;
 }
 
 TEST(Global_sign, PatchSlopeIsTheMedianEdgeSlopeWithinItsBounds)

@@ -137,6 +137,28 @@ TEST(Qpbo_i_solver, SameResultForSameSeed)
 }
 
 
+TEST(Solver_report, StartingLabelsAreTheInitialSolversLabels)
+{
+  // QPBO-I (reduced above 1000 vertices, unreduced below) and LSA-TR report
+  // the labelling of their `initial` MST, which the global stage's patches
+  // follow; the MST has no start.
+  std::mt19937_64 rng(23);
+  const int sizes[] = {12, 300, 3000};
+  for (int n : sizes) {
+    const Ugraph g = random_graph(rng, n, 3 * n, 0.35);
+    std::vector<NO::Label> start, out;
+    const NO::Qpbo_i_solver qpbo_i(3, 7);
+    const NO::Lsa_tr_solver lsa_tr;
+    solve(qpbo_i.initial, g, start);
+    const NO::Solver_report q = solve_report(qpbo_i, g, out);
+    EXPECT_EQ(q.starting_labels, start) << n;
+    solve(lsa_tr.initial, g, start);
+    const NO::Solver_report l = solve_report(lsa_tr, g, out);
+    EXPECT_EQ(l.starting_labels, start) << n;
+    EXPECT_TRUE(solve_report(NO::Mst_solver(), g, out).starting_labels.empty()) << n;
+  }
+}
+
 TEST(Lsa_tr_solver, NeverAboveMstNeverBelowOptimum)
 {
   std::mt19937_64 rng(21);

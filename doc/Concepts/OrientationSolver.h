@@ -60,6 +60,9 @@ public:
   /// energy of the labelling written (`Solver_report::energy`), the edges it leaves
   /// unsatisfied (`Solver_report::frustrated_edges`) and, for a solver that works on a
   /// reduced graph, its number of vertices (`Solver_report::segments`, 0 otherwise).
+  /// A solver that improves a starting labelling may report it
+  /// (`Solver_report::starting_labels`): the drivers' global stage then never puts
+  /// in one patch a vertex that the solver negated against it and one that it kept.
   /// \param g the graph: one pairwise term per edge
   /// \param weight the signed edge weights
   /// \param labels receives the label (+1 or -1) of every vertex

@@ -437,6 +437,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         internal::solve_core<has_constraints || has_prior>(solver, graph, weight, label_map, in, has_unary, result);
       result.frustrated_edges = sr.frustrated_edges;
       result.number_of_segments = sr.segments;
+      const std::vector<char> moved = internal::solver_moves(labels, sr.starting_labels);
       result.seconds.solve = internal::seconds_since(t);
       progress.part(Stage::SOLVE, 0.8, 0.9).report(1.0);
 
@@ -459,9 +460,8 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       // 5. The global stage: exterior visibility and the winding number decide the signs of patches.
       if (policies.global.orientation != Global_orientation::NONE) {
         progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
-        result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(graph, in.points, in.normals, component,
-                                                                            gr.radius, has_unary, policies.global,
-                                                                            labels);
+        result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(
+          graph, in.points, in.normals, component, gr.radius, has_unary, moved, policies.global, labels);
         result.seconds.global = result.global.seconds;
         // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
         if constexpr (!has_constraints && !has_prior) {

@@ -106,15 +106,16 @@ bool same_sheet(const Vector& mi, const Vector& mj, float slope, double max_slop
 
 /// Patches of the labelled cloud, numbered 0, 1, ... by their first point:
 /// the points joined by `same_sheet` edges (`slopes` from `edge_slopes()`,
-/// at most `max_slope`) within one cell of side `cell` (0: anywhere); then
-/// patches without a sample join a neighbouring patch through an edge whose
-/// oriented normals agree.
+/// at most `max_slope`) within one cell of side `cell` (0: anywhere) whose
+/// ends the solver either both negated or both kept against its start
+/// (`moved`, per point; empty: no start); then patches without a sample join
+/// a neighbouring patch through an edge whose oriented normals agree.
 /// Returns the patch of every point (zero normals get a patch of their own).
 template <typename Kernel>
 std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                                          const std::vector<typename Kernel::Vector_3>& normals,
-                                         const std::vector<Label>& labels, double cell,
-                                         const std::vector<float>& slopes, double max_slope,
+                                         const std::vector<Label>& labels, const std::vector<char>& moved,
+                                         double cell, const std::vector<float>& slopes, double max_slope,
                                          const std::vector<char>& is_sample, std::size_t& number_of_patches)
 {
   const std::size_t n = points.size();
@@ -130,12 +131,13 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std:
       for (int c = 0; c < 3; ++c)
         cells[i] = (cells[i] << 21) | (std::uint64_t((CGAL::to_double(points[i][c]) - lo[c]) / cell) & 0x1FFFFF);
   auto oriented = [&](std::size_t i) { return labels[i] < 0 ? -normals[i] : normals[i]; };
+  auto same_move = [&](std::size_t i, std::size_t j) { return moved.empty() || moved[i] == moved[j]; };
   Signed_union_find uf(n);
   typename boost::graph_traits<Neighbor_graph>::edge_iterator it, end;
   std::size_t e = 0;
   for (boost::tie(it, end) = edges(graph); it != end; ++it, ++e) {
     const std::size_t i = source(*it, graph), j = target(*it, graph);
-    if (cells[i] == cells[j] && same_sheet(oriented(i), oriented(j), slopes[e], max_slope))
+    if (cells[i] == cells[j] && same_move(i, j) && same_sheet(oriented(i), oriented(j), slopes[e], max_slope))
       uf.unite(Signed_union_find::Index(i), Signed_union_find::Index(j));
   }
   // Patches without a sample join a sampled neighbour (a few sweeps reach
@@ -168,6 +170,19 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std:
     patch[i] = id[r];
   }
   return patch;
+}
+
+/// Per point, whether the solver negated it against its start (`start`,
+/// per point; empty when the solver had none, and so is the result).
+inline std::vector<char> solver_moves(const std::vector<Label>& labels, const std::vector<Label>& start)
+{
+  std::vector<char> moved;
+  if (start.size() == labels.size()) {
+    moved.resize(labels.size());
+    for (std::size_t i = 0; i < labels.size(); ++i)
+      moved[i] = labels[i] != start[i];
+  }
+  return moved;
 }
 
 /// Adds the figures of one level of patches to `total`.
@@ -355,12 +370,13 @@ Core_samples<Kernel> core_samples(const std::vector<typename Kernel::Point_3>& p
 /// `labels` and adds the figures to `report`.  `sheets` (`number_of_sheets`
 /// of them, of slope at most `sheet_slope`) are the first level's patches
 /// when `labels` has not changed since they were built and the slopes agree,
-/// else empty.
+/// else empty; `moved` is that of `build_patches()`.
 template <typename ConcurrencyTag, typename Kernel>
 void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                          const std::vector<typename Kernel::Vector_3>& normals, const std::vector<float>& slopes,
                          const std::vector<std::uint32_t>& component, double radius,
-                         const std::vector<char>& has_unary, const Core_samples<Kernel>& samples,
+                         const std::vector<char>& has_unary, const std::vector<char>& moved,
+                         const Core_samples<Kernel>& samples,
                          const std::vector<std::uint32_t>& sheets, std::size_t number_of_sheets,
                          std::vector<Label>& labels, Global_sign_summary& report)
 {
@@ -373,7 +389,7 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
     std::size_t np = reuse ? number_of_sheets : 0;
     const std::vector<std::uint32_t> patch =
       reuse ? sheets
-            : build_patches<Kernel>(graph, points, normals, labels, cell_radii * radius, slopes, slope,
+            : build_patches<Kernel>(graph, points, normals, labels, moved, cell_radii * radius, slopes, slope,
                                     samples.is_sample, np);
     std::vector<std::uint32_t> spatch;
     for (std::uint32_t i : samples.index)
@@ -400,13 +416,16 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
 /// (the patches of the first level), that face away from where they were
 /// seen; the winding number then negates patches, level by level, and its
 /// flips against both the solver and visibility are undone in the sheets
-/// they turn away from where they were seen (`seen_side_vetoes()`).  Components with a point of `has_unary` keep their signs.
+/// they turn away from where they were seen (`seen_side_vetoes()`).
+/// Components with a point of `has_unary` keep their signs; no patch joins
+/// points that the solver negated against its start with points that it
+/// kept (`moved`, per point; empty: no start).
 template <typename ConcurrencyTag, typename Kernel>
 Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                                       const std::vector<typename Kernel::Vector_3>& normals,
                                       const std::vector<std::uint32_t>& component, double radius,
-                                      const std::vector<char>& has_unary, const Global_settings& settings,
-                                      std::vector<Label>& labels)
+                                      const std::vector<char>& has_unary, const std::vector<char>& moved,
+                                      const Global_settings& settings, std::vector<Label>& labels)
 {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = points.size();
@@ -424,7 +443,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   // 1. Exterior visibility.
   std::size_t number_of_sheets = 0;
   const std::vector<std::uint32_t> sheet =
-    build_patches<Kernel>(graph, points, normals, labels, 0.0, slopes, sheet_slope, samples.is_sample,
+    build_patches<Kernel>(graph, points, normals, labels, moved, 0.0, slopes, sheet_slope, samples.is_sample,
                           number_of_sheets);
   std::vector<std::uint32_t> sample_sheet(ns);
   for (std::size_t t = 0; t < ns; ++t)
@@ -444,7 +463,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   // (visibility flipped nothing: the sheets are the winding number's first level)
   const bool unchanged = seen.components_flipped == 0 && seen.patches_flipped == 0;
   core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, slopes, component, radius, has_unary,
-                                              samples, unchanged ? sheet : std::vector<std::uint32_t>(),
+                                              moved, samples, unchanged ? sheet : std::vector<std::uint32_t>(),
                                               number_of_sheets, labels, report);
   // 3. Its flips against both the solver and visibility, in the sheets they
   // turn away from where they were seen, are undone.

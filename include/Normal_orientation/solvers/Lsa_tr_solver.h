@@ -202,6 +202,7 @@ private:
       std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, unary, best, labels);
     else
       std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, best, labels);
+    report.starting_labels = std::move(y);
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;
   }

@@ -188,6 +188,7 @@ private:
       std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, unary, x, labels);
     else
       std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, x, labels);
+    report.starting_labels = std::move(y);
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;
   }

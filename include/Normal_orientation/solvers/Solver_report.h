@@ -6,7 +6,10 @@
 /// \file Solver_report.h
 /// What an `OrientationSolver` returns.
 
+#include <Normal_orientation/Orientation_problem.h>
+
 #include <cstddef>
+#include <vector>
 
 namespace Normal_orientation {
 
@@ -28,6 +31,11 @@ struct Solver_report
   std::size_t segments = 0;
   /// wall-clock seconds of the solve
   double seconds = 0.0;
+  /// the labelling the solver started from and improved, per vertex index
+  /// (QPBO-I and LSA-TR: their `initial` MST's), empty when it had none.
+  /// The drivers' global stage never joins, in one patch, a vertex that
+  /// the solver negated against it with one that it did not.
+  std::vector<Label> starting_labels;
 };
 
 } // namespace Normal_orientation
