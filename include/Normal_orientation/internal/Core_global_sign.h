@@ -54,6 +54,20 @@ double edge_slope(const Point& pi, const Point& pj, const Vector& mi, const Vect
   return std::min(1.0, std::max(da, db));
 }
 
+/// The settings of the winding number's search on one level of patches: a
+/// patch of `whole_sheets` (no cells: in core, the first level) is negated
+/// from half the default `Global_sign_options::minimum_decrease` per unit of
+/// its area, since its decrease is averaged over a whole sheet; patches cut
+/// by cells, or by the streamed segments, can be a few samples, whose
+/// changes of w noise and sampling make larger.
+inline Global_sign_options winding_level_options(bool whole_sheets)
+{
+  Global_sign_options o;
+  if (whole_sheets)
+    o.minimum_decrease = 0.5 * o.minimum_decrease;
+  return o;
+}
+
 /// The largest edge slope (`edge_slopes()`) of the sheets of exterior
 /// visibility and of the seen-side vetoes: 30 degrees from both tangent planes.
 constexpr double sheet_slope = 0.5;
@@ -402,8 +416,8 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
         fixed[patch[i]] = 1;
     }
     std::vector<char> flip;
-    const Global_sign_summary level =
-      search.template decide<ConcurrencyTag>(spatch, patch_component, fixed, flip, Global_sign_options());
+    const Global_sign_summary level = search.template decide<ConcurrencyTag>(spatch, patch_component, fixed, flip,
+                                                                             winding_level_options(cell_radii == 0.0));
     for (std::size_t i = 0; i < n; ++i)
       if (flip[patch[i]])
         labels[i] = Label(-labels[i]);

@@ -217,7 +217,8 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
       for (std::size_t j = 0; j < ns; ++j)
         fixed[patch[j]] |= segment_has_unary[samples.segment[j]];
     std::vector<char> flip;
-    const Global_sign_summary level = search.template decide<ConcurrencyTag>(patch, patch_component, fixed, flip);
+    const Global_sign_summary level = search.template decide<ConcurrencyTag>(
+      patch, patch_component, fixed, flip, Normal_orientation::internal::winding_level_options(false));
     for (std::size_t j = 0; j < ns; ++j)
       sample_flip[j] ^= flip[patch[j]];
     Normal_orientation::internal::add_level(report, level);
