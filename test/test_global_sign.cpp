@@ -27,6 +27,7 @@
 #endif
 
 #include <algorithm>
+#include <initializer_list>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -79,6 +80,34 @@ std::vector<Sample> touching_spheres(std::size_t n, std::mt19937_64& rng)
   for (const Sample& t : NO::test::sphere(n - n / 2, rng, Point(1, 0, 0), 1.0))
     s.push_back(t);
   return s;
+}
+
+/// A unit sphere of 8000 samples (seed 5) cut into octants (patch: x < 0 adds
+/// 1, y < 0 adds 2, z < 0 adds 4), the octants `inverted` facing inward, with
+/// the samples' areas.
+struct Octant_sphere
+{
+  std::vector<Sample> samples; ///< with their outward normals
+  std::vector<Point> points;
+  std::vector<Vector> normals; ///< outward but in the inverted octants
+  std::vector<std::uint32_t> patch;
+  std::vector<double> areas;
+};
+
+Octant_sphere octant_sphere(std::initializer_list<std::uint32_t> inverted)
+{
+  std::mt19937_64 rng(5);
+  Octant_sphere o;
+  o.samples = NO::test::sphere(8000, rng);
+  for (const Sample& t : o.samples) {
+    const std::uint32_t P = (t.p.x() < 0 ? 1 : 0) + (t.p.y() < 0 ? 2 : 0) + (t.p.z() < 0 ? 4 : 0);
+    const bool in = std::find(inverted.begin(), inverted.end(), P) != inverted.end();
+    o.points.push_back(t.p);
+    o.normals.push_back(in ? -t.n : t.n);
+    o.patch.push_back(P);
+  }
+  o.areas = NO::estimate_point_areas(o.points, o.normals);
+  return o;
 }
 
 /// an open spherical cap (z >= 0.5: a quarter of the sphere's area) with outward normals
@@ -157,18 +186,12 @@ TEST(Global_sign, DecidePatchSignsFixesInvertedPatchesOfAClosedSurface)
 {
   // A sphere cut into octants; three of them are inverted.  The stage negates
   // exactly those, and a fixed inverted octant stays as it is.
-  std::mt19937_64 rng(5);
-  const std::vector<Sample> s = NO::test::sphere(8000, rng);
-  std::vector<Point> p;
-  std::vector<Vector> n;
-  std::vector<std::uint32_t> patch;
-  for (const Sample& t : s) {
-    const std::uint32_t P = (t.p.x() < 0 ? 1 : 0) + (t.p.y() < 0 ? 2 : 0) + (t.p.z() < 0 ? 4 : 0);
-    p.push_back(t.p);
-    n.push_back(P == 1 || P == 2 || P == 7 ? -t.n : t.n);
-    patch.push_back(P);
-  }
-  const std::vector<double> a = NO::estimate_point_areas(p, n);
+  const Octant_sphere o = octant_sphere({1, 2, 7});
+  const std::vector<Sample>& s = o.samples;
+  const std::vector<Point>& p = o.points;
+  const std::vector<Vector>& n = o.normals;
+  const std::vector<std::uint32_t>& patch = o.patch;
+  const std::vector<double>& a = o.areas;
   const std::vector<std::uint32_t> component(8, 0);
   std::vector<char> flip;
   const NO::Global_sign_summary r = NO::decide_patch_signs(p, n, a, patch, component, {}, flip);
@@ -203,22 +226,14 @@ TEST(Global_sign, WholeSheetsNeedLessEvidence)
   // One inverted octant of a sphere lowers E by about 0.2 per unit of its
   // area when negated: below the default bound (0.3), above that of a level
   // of whole sheets (winding_level_options(true)).
-  std::mt19937_64 rng(5);
-  std::vector<Point> p;
-  std::vector<Vector> n;
-  std::vector<std::uint32_t> patch;
-  for (const Sample& t : NO::test::sphere(8000, rng)) {
-    const std::uint32_t P = (t.p.x() < 0 ? 1 : 0) + (t.p.y() < 0 ? 2 : 0) + (t.p.z() < 0 ? 4 : 0);
-    p.push_back(t.p);
-    n.push_back(P == 5 ? -t.n : t.n);
-    patch.push_back(P);
-  }
-  const std::vector<double> a = NO::estimate_point_areas(p, n);
+  const Octant_sphere o = octant_sphere({5});
   const std::vector<std::uint32_t> component(8, 0);
   std::vector<char> flip;
-  NO::decide_patch_signs(p, n, a, patch, component, {}, flip, NO::internal::winding_level_options(false));
+  NO::decide_patch_signs(o.points, o.normals, o.areas, o.patch, component, {}, flip,
+                         NO::internal::winding_level_options(false));
   EXPECT_EQ(flip, std::vector<char>(8, 0));
-  NO::decide_patch_signs(p, n, a, patch, component, {}, flip, NO::internal::winding_level_options(true));
+  NO::decide_patch_signs(o.points, o.normals, o.areas, o.patch, component, {}, flip,
+                         NO::internal::winding_level_options(true));
   EXPECT_EQ(flip, std::vector<char>({0, 0, 0, 0, 0, 1, 0, 0}));
 }
 
