@@ -4,6 +4,8 @@
 #define NORMAL_ORIENTATION_TEST_SYNTHETIC_SHAPES_H
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/pca_estimate_normals.h>
+#include <CGAL/property_map.h>
 
 #include <cmath>
 #include <random>
@@ -110,6 +112,28 @@ inline std::size_t count_wrong(const std::vector<Sample>& truth, const std::vect
   for (std::size_t i = 0; i < truth.size(); ++i)
     wrong += (truth[i].n * cloud[i].second <= 0.0) ? 1 : 0;
   return wrong;
+}
+
+/// `truth` with Gaussian position noise of deviation `sigma`, PCA normals
+/// over 18 neighbours and random signs
+inline std::vector<std::pair<Point, Vector>> noisy_cloud(const std::vector<Sample>& truth, double sigma, unsigned seed)
+{
+  typedef std::pair<Point, Vector> Point_with_normal;
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<Point_with_normal> cloud;
+  for (const Sample& s : truth) {
+    const double dz = g(rng), dy = g(rng), dx = g(rng); // (g++'s order, see sphere())
+    cloud.emplace_back(Point(s.p.x() + sigma * dx, s.p.y() + sigma * dy, s.p.z() + sigma * dz), Vector(0, 0, 1));
+  }
+  CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
+    cloud, 18,
+    CGAL::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
+      .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>()));
+  for (Point_with_normal& p : cloud)
+    if (rng() & 1)
+      p.second = -p.second;
+  return cloud;
 }
 
 } // namespace test

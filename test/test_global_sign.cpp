@@ -13,6 +13,7 @@
 
 #include <CGAL/pca_estimate_normals.h>
 
+#include "Counting_solver.h"
 #include "Hard_shapes.h"
 #include "Synthetic_shapes.h"
 
@@ -41,6 +42,7 @@ using NO::test::Kernel;
 using NO::test::Point;
 using NO::test::Sample;
 using NO::test::Vector;
+using NO::test::noisy_cloud;
 
 namespace {
 
@@ -492,26 +494,6 @@ std::vector<Sample> torus(std::size_t n, double R, double r, std::mt19937_64& rn
   return s;
 }
 
-/// `truth` with Gaussian position noise of deviation `sigma`, PCA normals
-/// over 18 neighbours and random signs
-std::vector<Point_with_normal> noisy_cloud(const std::vector<Sample>& truth, double sigma, unsigned seed)
-{
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> g(0.0, 1.0);
-  std::vector<Point_with_normal> cloud;
-  for (const Sample& s : truth)
-    cloud.emplace_back(Point(s.p.x() + sigma * g(rng), s.p.y() + sigma * g(rng), s.p.z() + sigma * g(rng)),
-                       Vector(0, 0, 1));
-  CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
-    cloud, 18,
-    CGAL::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
-      .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>()));
-  for (Point_with_normal& p : cloud)
-    if (rng() & 1)
-      p.second = -p.second;
-  return cloud;
-}
-
 /// the share of wrong normals among those whose line is within 60 degrees of the truth
 double clear_wrong(const std::vector<Point_with_normal>& cloud, const std::vector<Sample>& truth)
 {
@@ -647,6 +629,14 @@ TEST(Coarse_scale, NoiseWiderThanTheSpacingIsOrientedAtACoarserScale)
   EXPECT_TRUE(r.global.coarse_used);
   EXPECT_LE(after, 0.02);
   EXPECT_GE(before, 0.2);
+  // the coarse signs were taken against the labelling that QPBO-I starts
+  // from (its MST's): QPBO-I itself only ran on the coarse cloud
+  EXPECT_TRUE(r.global.coarse_before_solver);
+  const NO::test::Counting_solver counting;
+  std::vector<Point_with_normal> again = noisy_cloud(truth, 0.02, 32);
+  const NO::Orientation_result rc = NO::orient_normals(again, np.solver(counting));
+  EXPECT_TRUE(rc.global.coarse_before_solver);
+  EXPECT_EQ(*counting.sizes, std::vector<std::size_t>({rc.global.coarse_points}));
   // only signs change
   for (std::size_t i = 0; i < cloud.size(); ++i)
     EXPECT_TRUE(cloud[i].second == without[i].second || cloud[i].second == -without[i].second);

@@ -90,6 +90,7 @@ inline void json_global(Json_writer& j, const Normal_orientation::Global_sign_su
   j.key("energy_before").number(g.energy_before).key("energy_after").number(g.energy_after);
   j.key("coherence").number(g.coherence).key("coarse_points").integer(g.coarse_points);
   j.key("coarse_used").boolean(g.coarse_used);
+  j.key("coarse_before_solver").boolean(g.coarse_before_solver);
   j.key("seconds").fixed(g.seconds);
   j.end_object();
 }

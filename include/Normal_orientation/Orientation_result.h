@@ -45,6 +45,9 @@ struct Global_sign_summary
   double coherence = std::numeric_limits<double>::quiet_NaN();
   std::size_t coarse_points = 0;       ///< see `coherence`
   bool coarse_used = false;            ///< see `coherence`
+  /// the coarse signs were taken against the labelling that the solver
+  /// starts from (its `initial` MST), so that the solver itself did not run
+  bool coarse_before_solver = false;
 };
 
 /// \ingroup PkgNormalOrientationRef

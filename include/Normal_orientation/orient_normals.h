@@ -263,7 +263,11 @@ Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, Weig
 /// component sign policy fixes the free sign of every connected component;
 /// then, by default, the global sign stage lets the winding number of the
 /// cloud decide the signs of patches where it is closed (touching and
-/// nested objects, flat faces); finally n_i <- L_i n_i through the normal map.
+/// nested objects, flat faces), and where the input normals disagree (noise
+/// wider than the spacing) a coarser cloud may give the signs, in which case
+/// a solver with a starting solver (`initial`) does not run (see the manual,
+/// "Noise Wider than the Spacing"); finally n_i <- L_i n_i through the
+/// normal map.
 ///
 /// The input order is never changed and only the sign of normals changes
 /// (their length and direction are kept exactly).  Zero normals are left
@@ -430,53 +434,63 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       const auto label_map = CGAL::make_property_map(labels);
       result.energy_before = energy(graph, weight, label_map);
 
-      // 3. Solve, with unary terms when there are constraints or priors.
-      auto t = std::chrono::steady_clock::now();
+      // 3-5. Solve (with unary terms when there are constraints or priors),
+      // give every component its sign, then the global stage.
       std::vector<char> has_unary; // per vertex, with unary terms only
-      const Solver_report sr =
-        internal::solve_core<has_constraints || has_prior>(solver, graph, weight, label_map, in, has_unary, result);
-      result.frustrated_edges = sr.frustrated_edges;
-      result.number_of_segments = sr.segments;
-      const std::vector<char> moved = internal::solver_moves(labels, sr.starting_labels);
-      result.seconds.solve = internal::seconds_since(t);
-      progress.part(Stage::SOLVE, 0.8, 0.9).report(1.0);
+      auto fine = [&](const auto& the_solver, bool) {
+        auto t = std::chrono::steady_clock::now();
+        std::fill(labels.begin(), labels.end(), Label(1));
+        const Solver_report sr = internal::solve_core<has_constraints || has_prior>(the_solver, graph, weight, label_map,
+                                                                                    in, has_unary, result);
+        result.frustrated_edges = sr.frustrated_edges;
+        result.number_of_segments = sr.segments;
+        const std::vector<char> moved = internal::solver_moves(labels, sr.starting_labels);
+        result.seconds.solve += internal::seconds_since(t);
+        progress.part(Stage::SOLVE, 0.8, 0.9).report(1.0);
 
-      // 4. Components and their signs.
-      t = std::chrono::steady_clock::now();
-      std::vector<std::uint32_t> component;
-      result.number_of_components = connected_components(graph, weight, component);
-      const Component_sign_input<Kernel> input{in.points, in.normals, labels, component, result.number_of_components,
-                                               gr.radius, has_constraints ? &in.constrained : nullptr};
-      std::vector<char> flip = component_signs(sign_policy, input);
-      for (std::size_t i = 0; i < has_unary.size(); ++i) // the solver gave these components their sign
-        if (has_unary[i])
-          flip[component[i]] = 0;
-      for (std::size_t i = 0; i < n; ++i)
-        if (flip[component[i]])
-          labels[i] = Label(-labels[i]);
-      result.seconds.sign = internal::seconds_since(t);
-      progress.part(Stage::SIGN, 0.9, 0.92).report(1.0);
+        t = std::chrono::steady_clock::now();
+        std::vector<std::uint32_t> component;
+        result.number_of_components = connected_components(graph, weight, component);
+        const Component_sign_input<Kernel> input{in.points, in.normals, labels, component, result.number_of_components,
+                                                 gr.radius, has_constraints ? &in.constrained : nullptr};
+        std::vector<char> flip = component_signs(sign_policy, input);
+        for (std::size_t i = 0; i < has_unary.size(); ++i) // the solver gave these components their sign
+          if (has_unary[i])
+            flip[component[i]] = 0;
+        for (std::size_t i = 0; i < n; ++i)
+          if (flip[component[i]])
+            labels[i] = Label(-labels[i]);
+        result.seconds.sign += internal::seconds_since(t);
+        progress.part(Stage::SIGN, 0.9, 0.92).report(1.0);
 
-      // 5. The global stage: exterior visibility and the winding number decide the signs of patches.
-      if (policies.global.orientation != Global_orientation::NONE) {
-        progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
-        result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(
-          graph, in.points, in.normals, component, gr.radius, has_unary, moved, policies.global, labels);
-        result.seconds.global = result.global.seconds;
-        // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
-        if constexpr (!has_constraints && !has_prior) {
-          const internal::Coarse_scale_report coarse = internal::core_coarse_signs<ConcurrencyTag, Kernel>(
-            in.points, in.normals, gr.radius, labels, result.global.closedness, [&](auto& cloud) {
-              return orient_normals<ConcurrencyTag>(
-                       cloud, internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, policies.global))
-                .global.closedness;
-            });
-          result.global.coherence = coarse.coherence;
-          result.global.coarse_points = coarse.coarse_points;
-          result.global.coarse_used = coarse.used;
-          result.global.seconds += coarse.seconds;
-          result.seconds.global += coarse.seconds;
+        if (policies.global.orientation != Global_orientation::NONE) {
+          progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
+          result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(
+            graph, in.points, in.normals, component, gr.radius, has_unary, moved, policies.global, labels);
+          result.seconds.global += result.global.seconds;
         }
+      };
+      // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
+      constexpr bool coarse_pass = !has_constraints && !has_prior; // (no pass with unary terms)
+      if (coarse_pass && policies.global.orientation != Global_orientation::NONE) {
+        internal::Core_coarse_pass<ConcurrencyTag, Kernel> pass(in.points, in.normals, gr.radius);
+        auto orient_coarse = [&](auto& cloud) {
+          return orient_normals<ConcurrencyTag>(
+                   cloud, internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, policies.global))
+            .global.closedness;
+        };
+        const bool before = internal::solve_around_coarse_pass(pass.runs(), solver, fine, [&]() {
+          return pass.apply(labels, result.global.closedness, orient_coarse);
+        });
+        const internal::Coarse_scale_report coarse = pass.report();
+        result.global.coarse_before_solver = before;
+        result.global.coherence = coarse.coherence;
+        result.global.coarse_points = coarse.coarse_points;
+        result.global.coarse_used = coarse.used;
+        result.global.seconds += coarse.seconds;
+        result.seconds.global += coarse.seconds;
+      } else {
+        fine(solver, true);
       }
       result.energy_after = energy(graph, weight, label_map);
       for (std::size_t q = 0; q < n; ++q)

@@ -223,73 +223,76 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   sweep_progress.report(n, n);
   result.seconds.sweep = seconds_since(t);
 
-  // 5. The segment graph and its solution.
-  t = Clock::now();
-  stage(Stage::SOLVE).report(0, 1);
-  const Segment_solution solution = solve_segment_graph_stage(segmenter, solver, Unary::enabled);
-  result.number_of_segments = segmenter.number_of_segments();
-  result.number_of_segment_edges = solution.number_of_segment_edges;
-  result.segment_energy_before = solution.energy_before;
-  result.segment_energy_after = solution.energy_after;
-  result.number_of_components = solution.number_of_components;
-  stage(Stage::SOLVE).report(1, 1);
-  result.seconds.solve = seconds_since(t);
-
-  // 6. The refinement, skipped when no edge contradicts the labelling (its
-  //    energy, known from the segment graph, is 0): nothing could improve it.
+  // 5-8. The segment graph and its solution, the refinement (skipped when
+  // no edge contradicts the labelling: its energy, known from the segment
+  // graph, is 0), the sign of every component, then the global stage
+  // (exterior visibility and the winding number of a subsample).
+  Segment_solution solution;
   Point_labels labels;
-  labels.segment_labels = solution.labels;
-  result.energy_before_refinement = segmenter.point_energy(solution.labels);
-  result.energy_after_refinement = result.energy_before_refinement;
-  if (refine) {
+  std::vector<char> flip_component;
+  Labelled_reader points(records, labels);
+  auto fine = [&](const auto& the_solver, bool with_refinement) {
     t = Clock::now();
-    const unsigned int rounds = result.energy_before_refinement > 0.0 ? settings.refinement.rounds : 0;
-    const Refine_stage_result rr = refine_stage<ConcurrencyTag>(
-      records, *edges, n, result.edge_span, settings.refinement, rounds, settings.temporary_directory, solver,
-      result.energy_before_refinement, labels, stage(Stage::REFINE));
-    result.energy_after_refinement = rr.energy_after;
-    result.refinement_rounds_accepted = rr.rounds_accepted;
-    result.refinement_moves = rr.moves;
-    result.seconds.refine = seconds_since(t);
+    stage(Stage::SOLVE).report(0, 1);
+    solution = solve_segment_graph_stage(segmenter, the_solver, Unary::enabled);
+    result.number_of_segments = segmenter.number_of_segments();
+    result.number_of_segment_edges = solution.number_of_segment_edges;
+    result.segment_energy_before = solution.energy_before;
+    result.segment_energy_after = solution.energy_after;
+    result.number_of_components = solution.number_of_components;
+    stage(Stage::SOLVE).report(1, 1);
+    result.seconds.solve += seconds_since(t);
+
+    labels.segment_labels = solution.labels;
+    labels.label_file.reset();
+    labels.label_file_segment_labels.clear();
+    labels.point_flip = nullptr;
+    result.energy_before_refinement = segmenter.point_energy(solution.labels);
+    result.energy_after_refinement = result.energy_before_refinement;
+    if (refine && with_refinement) {
+      t = Clock::now();
+      const unsigned int rounds = result.energy_before_refinement > 0.0 ? settings.refinement.rounds : 0;
+      const Refine_stage_result rr = refine_stage<ConcurrencyTag>(
+        records, *edges, n, result.edge_span, settings.refinement, rounds, settings.temporary_directory, the_solver,
+        result.energy_before_refinement, labels, stage(Stage::REFINE));
+      result.energy_after_refinement = rr.energy_after;
+      result.refinement_rounds_accepted = rr.rounds_accepted;
+      result.refinement_moves = rr.moves;
+      result.seconds.refine = seconds_since(t);
+    }
+    result.energy_after = result.energy_after_refinement;
+
+    t = Clock::now();
+    flip_component = sign_stage(
+      sign_policy, [&unary](const Point_record& r) { return unary.is_constrained(r); }, points, solution.component,
+      solution.number_of_components, swept.segment_size, swept.segment_has_unary, radius, n, stage(Stage::SIGN));
+    result.seconds.sign += seconds_since(t);
+
+    if (global.orientation != Global_orientation::NONE) {
+      t = Clock::now();
+      result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component,
+                                                   swept.segment_has_unary, radius, n, global, stage(Stage::GLOBAL));
+      result.seconds.global += seconds_since(t);
+    }
+  };
+  // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
+  if (!Unary::enabled && global.orientation != Global_orientation::NONE) {
+    auto orient_coarse = [&](const Normal_orientation::internal::Coarse_scale& c) {
+      auto cloud = Normal_orientation::internal::make_coarse_cloud<Kernel>(c);
+      const double closedness =
+        orient_normals<ConcurrencyTag>(
+          cloud, Normal_orientation::internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, global))
+          .global.closedness;
+      return std::make_pair(Normal_orientation::internal::coarse_cloud_normals(cloud), closedness);
+    };
+    coarse_stage(records, radius, n, solver, fine, orient_coarse, labels, solution.component, flip_component,
+                 result.global, result.seconds.global);
+  } else {
+    fine(solver, true);
   }
   edges.reset(); // removes the edge file
-  result.energy_after = result.energy_after_refinement;
-
-  // 7. The sign of every component.
-  t = Clock::now();
-  Labelled_reader points(records, labels);
-  std::vector<char> flip_component = sign_stage(
-    sign_policy, [&unary](const Point_record& r) { return unary.is_constrained(r); }, points, solution.component,
-    solution.number_of_components, swept.segment_size, swept.segment_has_unary, radius, n, stage(Stage::SIGN));
-  result.seconds.sign = seconds_since(t);
-
-  // 8. The global stage: exterior visibility, then the winding number, of a subsample decide
-  // the signs of components and segments.
-  if (global.orientation != Global_orientation::NONE) {
-    t = Clock::now();
-    result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component,
-                                                 swept.segment_has_unary, radius, n, global, stage(Stage::GLOBAL));
-    // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
-    if constexpr (!Unary::enabled) {
-      const auto coarse = coarse_stage(
-        points, labels, solution.component, flip_component, radius, n, result.global.closedness,
-        [&](const Normal_orientation::internal::Coarse_scale& c) {
-          auto cloud = Normal_orientation::internal::make_coarse_cloud<Kernel>(c);
-          const double closedness =
-            orient_normals<ConcurrencyTag>(
-              cloud, Normal_orientation::internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, global))
-              .global.closedness;
-          return std::make_pair(Normal_orientation::internal::coarse_cloud_normals(cloud), closedness);
-        });
-      result.global.coherence = coarse.coherence;
-      result.global.coarse_points = coarse.coarse_points;
-      result.global.coarse_used = coarse.used;
-      result.global.seconds += coarse.seconds;
-    }
-    result.seconds.global = seconds_since(t);
-    if (labels.point_flip) // (point by point: the energy of the output is not measured)
-      result.energy_after = std::numeric_limits<double>::quiet_NaN();
-  }
+  if (global.orientation != Global_orientation::NONE && labels.point_flip)
+    result.energy_after = std::numeric_limits<double>::quiet_NaN(); // (point by point: not measured)
 
   // 9. Output, without the small components.
   std::vector<std::uint64_t> size(solution.number_of_components, 0);

@@ -33,6 +33,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <type_traits>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -384,6 +385,39 @@ private:
   std::vector<std::array<double, 3>> m_points, m_normals;
   Coarse_scale_report m_report;
 };
+
+/// Whether `Solver` improves the labelling of a solver of its own, its
+/// public member `initial` (`Qpbo_i_solver`, `Lsa_tr_solver`).
+template <typename Solver, typename = void>
+struct Has_starting_solver : std::false_type
+{};
+template <typename Solver>
+struct Has_starting_solver<Solver, std::void_t<decltype(std::declval<const Solver&>().initial)>> : std::true_type
+{};
+
+/// The order of the solve and of the coarse-to-fine pass, in both drivers.
+/// `fine(solver, improve)` labels the cloud with `solver` and runs what
+/// follows it up to the global stage (`improve`: with the streamed
+/// refinement); `apply()` tries the pass against that labelling and returns
+/// whether the coarse signs were taken.  Where the pass runs (`pass_runs`)
+/// and `solver` starts from another, the pass is first tried against the
+/// labelling of that start, unimproved: when it is taken, `solver` never
+/// runs on the cloud.  Returns whether that happened.
+template <typename Solver, typename Fine, typename Apply>
+bool solve_around_coarse_pass(bool pass_runs, const Solver& solver, const Fine& fine, const Apply& apply)
+{
+  if constexpr (Has_starting_solver<Solver>::value) {
+    if (pass_runs) {
+      fine(solver.initial, false);
+      if (apply())
+        return true;
+    }
+  }
+  fine(solver, true);
+  if (pass_runs)
+    apply();
+  return false;
+}
 
 } // namespace internal
 /// \endcond

@@ -24,6 +24,7 @@
 #include <chrono>
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -105,52 +106,99 @@ std::vector<std::array<double, 3>> coarse_cloud_normals(const std::vector<Coarse
   return normals;
 }
 
-/// Runs the coarse-to-fine pass on the in-core cloud `points` / unit
-/// `normals` (zero allowed), whose current `labels` have the closedness
-/// `fine_closedness`.  `orient(std::vector<Coarse_cloud_point<Kernel>>&)`
-/// must orient the coarse cloud in place with the pipeline and return the
-/// closedness of the result.  When the coarse signs are used, every label
-/// becomes the one that makes its normal agree with the nearest coarse
-/// normal (unchanged where there is none).
-template <typename ConcurrencyTag, typename Kernel, typename Orient>
-Coarse_scale_report core_coarse_signs(const std::vector<typename Kernel::Point_3>& points,
-                                      const std::vector<typename Kernel::Vector_3>& normals, double radius,
-                                      std::vector<Label>& labels, double fine_closedness, const Orient& orient)
+/// The coarse-to-fine pass on the in-core cloud `points` / unit `normals`
+/// (zero allowed): the constructor measures whether the input normals agree
+/// (`runs()`: they do not, and the pass is to be tried); `apply()` orients
+/// the coarse cloud (once, whatever the number of calls) and, when it is more
+/// closed than the fine labelling, gives every label the sign that makes its
+/// normal agree with the nearest coarse normal (unchanged where there is
+/// none).
+template <typename ConcurrencyTag, typename Kernel>
+class Core_coarse_pass
 {
-  const auto t = std::chrono::steady_clock::now();
-  const std::size_t n = points.size();
-  auto position = [&](std::size_t i) {
-    return std::array<double, 3>{{CGAL::to_double(points[i].x()), CGAL::to_double(points[i].y()),
-                                  CGAL::to_double(points[i].z())}};
-  };
-  auto direction = [&](std::size_t i) {
-    return std::array<double, 3>{{CGAL::to_double(normals[i].x()), CGAL::to_double(normals[i].y()),
-                                  CGAL::to_double(normals[i].z())}};
-  };
-  Coarse_scale coarse(radius);
-  for (std::size_t i = 0; i < n; ++i)
-    coarse.add(position(i), direction(i));
-  if (coarse.decide(n)) {
-    std::vector<Coarse_cloud_point<Kernel>> cloud = make_coarse_cloud<Kernel>(coarse);
-    const double closedness = orient(cloud);
-    if (coarse.use_coarse_orientation(coarse_cloud_normals(cloud), closedness, fine_closedness)) {
+public:
+  Core_coarse_pass(const std::vector<typename Kernel::Point_3>& points,
+                   const std::vector<typename Kernel::Vector_3>& normals, double radius)
+    : m_points(points), m_normals(normals), m_coarse(std::make_unique<Coarse_scale>(radius))
+  {
+    const auto t = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < points.size(); ++i)
+      m_coarse->add(position(i), direction(i));
+    m_runs = m_coarse->decide(points.size());
+    m_report = m_coarse->report();
+    if (!m_runs)
+      m_coarse.reset(); // its grid is not needed any more
+    m_seconds = seconds_since(t);
+  }
+
+  /// whether the input normals disagree enough for the pass to be tried
+  bool runs() const { return m_runs; }
+
+  /// The pass against the fine `labels`, whose closedness is
+  /// `fine_closedness`; `orient(std::vector<Coarse_cloud_point<Kernel>>&)`
+  /// orients the coarse cloud in place with the pipeline and returns the
+  /// closedness of the result.  Returns whether the coarse signs were taken.
+  template <typename Orient>
+  bool apply(std::vector<Label>& labels, double fine_closedness, const Orient& orient)
+  {
+    if (!m_runs)
+      return false;
+    const auto t = std::chrono::steady_clock::now();
+    if (!m_oriented) {
+      std::vector<Coarse_cloud_point<Kernel>> cloud = make_coarse_cloud<Kernel>(*m_coarse);
+      m_coarse_closedness = orient(cloud);
+      m_coarse_normals = coarse_cloud_normals(cloud);
+      m_oriented = true;
+    }
+    bool used = false;
+    if (m_coarse->use_coarse_orientation(m_coarse_normals, m_coarse_closedness, fine_closedness)) {
+      used = true;
+      const std::size_t n = m_points.size();
       std::vector<char> flipped(n, 0);
       parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
-          const signed char s = coarse.sign(position(i), direction(i));
+          const signed char s = m_coarse->sign(position(i), direction(i));
           if (s != 0 && s != labels[i]) {
             labels[i] = Label(s);
             flipped[i] = 1;
           }
         }
       });
+      m_coarse->report().points_flipped = 0;
       for (std::size_t i = 0; i < n; ++i)
-        coarse.report().points_flipped += std::uint64_t(flipped[i]);
+        m_coarse->report().points_flipped += std::uint64_t(flipped[i]);
     }
+    m_report = m_coarse->report();
+    m_seconds += seconds_since(t);
+    return used;
   }
-  coarse.report().seconds = seconds_since(t);
-  return coarse.report();
-}
+
+  /// what the pass measured and did, with the seconds of all its calls
+  Coarse_scale_report report() const
+  {
+    Coarse_scale_report r = m_report;
+    r.seconds = m_seconds;
+    return r;
+  }
+
+private:
+  std::array<double, 3> position(std::size_t i) const
+  {
+    return {{CGAL::to_double(m_points[i].x()), CGAL::to_double(m_points[i].y()), CGAL::to_double(m_points[i].z())}};
+  }
+  std::array<double, 3> direction(std::size_t i) const
+  {
+    return {{CGAL::to_double(m_normals[i].x()), CGAL::to_double(m_normals[i].y()), CGAL::to_double(m_normals[i].z())}};
+  }
+
+  const std::vector<typename Kernel::Point_3>& m_points;
+  const std::vector<typename Kernel::Vector_3>& m_normals;
+  std::unique_ptr<Coarse_scale> m_coarse; ///< (released when the pass does not run)
+  Coarse_scale_report m_report;
+  bool m_runs = false, m_oriented = false;
+  double m_coarse_closedness = 0.0, m_seconds = 0.0;
+  std::vector<std::array<double, 3>> m_coarse_normals;
+};
 
 } // namespace internal
 /// \endcond
