@@ -243,10 +243,8 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     stage(Stage::SOLVE).report(1, 1);
     result.seconds.solve += seconds_since(t);
 
+    labels = Point_labels(); // (a second call starts afresh)
     labels.segment_labels = solution.labels;
-    labels.label_file.reset();
-    labels.label_file_segment_labels.clear();
-    labels.point_flip = nullptr;
     result.energy_before_refinement = segmenter.point_energy(solution.labels);
     result.energy_after_refinement = result.energy_before_refinement;
     if (refine && with_refinement) {
@@ -277,16 +275,13 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   };
   // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
   if (!Unary::enabled && global.orientation != Global_orientation::NONE) {
-    auto orient_coarse = [&](const Normal_orientation::internal::Coarse_scale& c) {
-      auto cloud = Normal_orientation::internal::make_coarse_cloud<Kernel>(c);
-      const double closedness =
-        orient_normals<ConcurrencyTag>(
-          cloud, Normal_orientation::internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, global))
-          .global.closedness;
-      return std::make_pair(Normal_orientation::internal::coarse_cloud_normals(cloud), closedness);
+    auto orient_coarse = [&](auto& cloud) {
+      return orient_normals<ConcurrencyTag>(
+               cloud, Normal_orientation::internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, global))
+        .global.closedness;
     };
-    coarse_stage(records, radius, n, solver, fine, orient_coarse, labels, solution.component, flip_component,
-                 result.global, result.seconds.global);
+    coarse_stage<Kernel>(records, radius, n, solver, fine, orient_coarse, labels, solution.component, flip_component,
+                         result.global, result.seconds.global);
   } else {
     fine(solver, true);
   }

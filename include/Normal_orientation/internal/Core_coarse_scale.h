@@ -4,9 +4,11 @@
 #define NORMAL_ORIENTATION_INTERNAL_CORE_COARSE_SCALE_H
 
 /// \file Core_coarse_scale.h
-/// The in-core driver of the coarse-to-fine pass (`Coarse_scale.h`): it feeds
-/// the accumulator from the vectors of the in-core pipeline, has the coarse
-/// cloud oriented by the caller and gives every point the coarse sign.
+/// The coarse-to-fine pass (`Coarse_scale.h`) as the pipeline runs it: the
+/// coarse cloud in the pipeline's own point type, what both drivers' passes
+/// share (`Coarse_pass`: the accumulator, the coarse cloud oriented once by
+/// the caller), and the in-core pass, which feeds the accumulator from the
+/// vectors of the in-core pipeline and gives every point the coarse sign.
 
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Orientation_problem.h>
@@ -106,72 +108,17 @@ std::vector<std::array<double, 3>> coarse_cloud_normals(const std::vector<Coarse
   return normals;
 }
 
-/// The coarse-to-fine pass on the in-core cloud `points` / unit `normals`
-/// (zero allowed): the constructor measures whether the input normals agree
-/// (`runs()`: they do not, and the pass is to be tried); `apply()` orients
-/// the coarse cloud (once, whatever the number of calls) and, when it is more
-/// closed than the fine labelling, gives every label the sign that makes its
-/// normal agree with the nearest coarse normal (unchanged where there is
-/// none).
-template <typename ConcurrencyTag, typename Kernel>
-class Core_coarse_pass
+/// What the coarse-to-fine passes of both drivers share: the accumulator,
+/// which the driver feeds (`accumulator()`) before `finish()` decides
+/// whether the pass runs (the grid is released when it does not), and
+/// `take_coarse()`, which orients the coarse cloud once, whatever the number
+/// of calls, and decides against the closedness of a fine orientation.
+template <typename Kernel>
+class Coarse_pass
 {
 public:
-  Core_coarse_pass(const std::vector<typename Kernel::Point_3>& points,
-                   const std::vector<typename Kernel::Vector_3>& normals, double radius)
-    : m_points(points), m_normals(normals), m_coarse(std::make_unique<Coarse_scale>(radius))
-  {
-    const auto t = std::chrono::steady_clock::now();
-    for (std::size_t i = 0; i < points.size(); ++i)
-      m_coarse->add(position(i), direction(i));
-    m_runs = m_coarse->decide(points.size());
-    m_report = m_coarse->report();
-    if (!m_runs)
-      m_coarse.reset(); // its grid is not needed any more
-    m_seconds = seconds_since(t);
-  }
-
   /// whether the input normals disagree enough for the pass to be tried
   bool runs() const { return m_runs; }
-
-  /// The pass against the fine `labels`, whose closedness is
-  /// `fine_closedness`; `orient(std::vector<Coarse_cloud_point<Kernel>>&)`
-  /// orients the coarse cloud in place with the pipeline and returns the
-  /// closedness of the result.  Returns whether the coarse signs were taken.
-  template <typename Orient>
-  bool apply(std::vector<Label>& labels, double fine_closedness, const Orient& orient)
-  {
-    if (!m_runs)
-      return false;
-    const auto t = std::chrono::steady_clock::now();
-    if (!m_oriented) {
-      std::vector<Coarse_cloud_point<Kernel>> cloud = make_coarse_cloud<Kernel>(*m_coarse);
-      m_coarse_closedness = orient(cloud);
-      m_coarse_normals = coarse_cloud_normals(cloud);
-      m_oriented = true;
-    }
-    bool used = false;
-    if (m_coarse->use_coarse_orientation(m_coarse_normals, m_coarse_closedness, fine_closedness)) {
-      used = true;
-      const std::size_t n = m_points.size();
-      std::vector<char> flipped(n, 0);
-      parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) {
-          const signed char s = m_coarse->sign(position(i), direction(i));
-          if (s != 0 && s != labels[i]) {
-            labels[i] = Label(s);
-            flipped[i] = 1;
-          }
-        }
-      });
-      m_coarse->report().points_flipped = 0;
-      for (std::size_t i = 0; i < n; ++i)
-        m_coarse->report().points_flipped += std::uint64_t(flipped[i]);
-    }
-    m_report = m_coarse->report();
-    m_seconds += seconds_since(t);
-    return used;
-  }
 
   /// what the pass measured and did, with the seconds of all its calls
   Coarse_scale_report report() const
@@ -179,6 +126,103 @@ public:
     Coarse_scale_report r = m_report;
     r.seconds = m_seconds;
     return r;
+  }
+
+protected:
+  explicit Coarse_pass(double radius) : m_coarse(std::make_shared<Coarse_scale>(radius)) {}
+
+  Coarse_scale& accumulator() { return *m_coarse; }
+
+  /// decides whether the pass runs, for a cloud of `n` points
+  void finish(std::size_t n)
+  {
+    m_runs = m_coarse->decide(n);
+    m_report = m_coarse->report();
+    if (!m_runs)
+      m_coarse.reset(); // its grid is not needed any more
+  }
+
+  /// Whether the points are to take the coarse signs against a fine
+  /// orientation of closedness `fine_closedness`;
+  /// `orient(std::vector<Coarse_cloud_point<Kernel>>&)` orients the coarse
+  /// cloud in place with the pipeline and returns the closedness of the
+  /// result (called once).  `runs()` must be true.
+  template <typename Orient>
+  bool take_coarse(double fine_closedness, const Orient& orient)
+  {
+    if (!m_oriented) {
+      std::vector<Coarse_cloud_point<Kernel>> cloud = make_coarse_cloud<Kernel>(*m_coarse);
+      m_coarse_closedness = orient(cloud);
+      m_coarse_normals = coarse_cloud_normals(cloud);
+      m_oriented = true;
+    }
+    const bool used = m_coarse->use_coarse_orientation(m_coarse_normals, m_coarse_closedness, fine_closedness);
+    m_report = m_coarse->report();
+    return used;
+  }
+
+  std::shared_ptr<Coarse_scale> m_coarse; ///< (released when the pass does not run)
+  Coarse_scale_report m_report;
+  double m_seconds = 0.0; ///< of all the calls
+
+private:
+  bool m_runs = false, m_oriented = false;
+  double m_coarse_closedness = 0.0;
+  std::vector<std::array<double, 3>> m_coarse_normals;
+};
+
+/// The coarse-to-fine pass on the in-core cloud `points` / unit `normals`
+/// (zero allowed): the constructor measures whether the input normals agree
+/// (`runs()`: they do not, and the pass is to be tried); `apply()`, when the
+/// coarse cloud is more closed than the fine labelling, gives every label the
+/// sign that makes its normal agree with the nearest coarse normal (unchanged
+/// where there is none).
+template <typename ConcurrencyTag, typename Kernel>
+class Core_coarse_pass : public Coarse_pass<Kernel>
+{
+  typedef Coarse_pass<Kernel> Base;
+
+public:
+  Core_coarse_pass(const std::vector<typename Kernel::Point_3>& points,
+                   const std::vector<typename Kernel::Vector_3>& normals, double radius)
+    : Base(radius), m_points(points), m_normals(normals)
+  {
+    const auto t = std::chrono::steady_clock::now();
+    for (std::size_t i = 0; i < points.size(); ++i)
+      this->accumulator().add(position(i), direction(i));
+    this->finish(points.size());
+    this->m_seconds += seconds_since(t);
+  }
+
+  /// The pass against the fine `labels`, whose closedness is
+  /// `fine_closedness` (`orient` as for `Coarse_pass::take_coarse()`).
+  /// Returns whether the coarse signs were taken.
+  template <typename Orient>
+  bool apply(std::vector<Label>& labels, double fine_closedness, const Orient& orient)
+  {
+    if (!this->runs())
+      return false;
+    const auto t = std::chrono::steady_clock::now();
+    const bool used = this->take_coarse(fine_closedness, orient);
+    if (used) {
+      const std::size_t n = m_points.size();
+      const Coarse_scale& coarse = *this->m_coarse;
+      std::vector<char> flipped(n, 0);
+      parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+          const signed char s = coarse.sign(position(i), direction(i));
+          if (s != 0 && s != labels[i]) {
+            labels[i] = Label(s);
+            flipped[i] = 1;
+          }
+        }
+      });
+      this->m_report.points_flipped = 0;
+      for (std::size_t i = 0; i < n; ++i)
+        this->m_report.points_flipped += std::uint64_t(flipped[i]);
+    }
+    this->m_seconds += seconds_since(t);
+    return used;
   }
 
 private:
@@ -193,11 +237,6 @@ private:
 
   const std::vector<typename Kernel::Point_3>& m_points;
   const std::vector<typename Kernel::Vector_3>& m_normals;
-  std::unique_ptr<Coarse_scale> m_coarse; ///< (released when the pass does not run)
-  Coarse_scale_report m_report;
-  bool m_runs = false, m_oriented = false;
-  double m_coarse_closedness = 0.0, m_seconds = 0.0;
-  std::vector<std::array<double, 3>> m_coarse_normals;
 };
 
 } // namespace internal

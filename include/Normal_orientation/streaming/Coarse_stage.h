@@ -12,6 +12,7 @@
 
 #include <Normal_orientation/Orientation_result.h>
 #include <Normal_orientation/internal/Coarse_scale.h>
+#include <Normal_orientation/internal/Core_coarse_scale.h>
 #include <Normal_orientation/internal/Settings.h>
 #include <Normal_orientation/streaming/Labelled_records.h>
 #include <Normal_orientation/streaming/Segmenting_sweep.h>
@@ -30,22 +31,22 @@ namespace internal {
 
 /// The coarse-to-fine pass on the records: the constructor reads them once
 /// into the accumulator and measures whether their input normals agree
-/// (`runs()`: they do not, and the pass is to be tried).  `apply()` orients
-/// the coarse cloud (once, whatever the number of calls; `orient(const
-/// Coarse_scale&)` must orient it with the in-core pipeline and return the
-/// oriented normals and the closedness of the result, as a pair) and, when it
-/// is more closed than the fine orientation (`fine_closedness`), installs the
+/// (`runs()`: they do not, and the pass is to be tried).  `apply()`, when
+/// the coarse cloud is more closed than the fine orientation
+/// (`fine_closedness`; `orient` as for
+/// `Normal_orientation::internal::Coarse_pass::take_coarse()`), installs the
 /// coarse signs in `labels` before the global stage's decision, which is kept
 /// for the points without a coarse opinion.  `component` is per sweep
 /// segment, `flip_component` the sign stage's decision; both must outlive the
 /// output passes.
-class Stream_coarse_pass
+template <typename Kernel>
+class Stream_coarse_pass : public Normal_orientation::internal::Coarse_pass<Kernel>
 {
+  typedef Normal_orientation::internal::Coarse_pass<Kernel> Base;
   typedef Normal_orientation::internal::Coarse_scale Coarse_scale;
 
 public:
-  Stream_coarse_pass(Record_file<Swept_record>& records, double radius, std::uint64_t n)
-    : m_coarse(std::make_shared<Coarse_scale>(radius))
+  Stream_coarse_pass(Record_file<Swept_record>& records, double radius, std::uint64_t n) : Base(radius)
   {
     const auto t = std::chrono::steady_clock::now();
     records.rewind();
@@ -56,19 +57,13 @@ public:
         break;
       for (const Swept_record& s : chunk) {
         const Point_record& r = s.record;
-        m_coarse->add({{r.position[0], r.position[1], r.position[2]}}, unit_normal(r));
+        this->accumulator().add({{r.position[0], r.position[1], r.position[2]}}, unit_normal(r));
       }
     }
     records.rewind();
-    m_runs = m_coarse->decide(std::size_t(n));
-    m_report = m_coarse->report();
-    if (!m_runs)
-      m_coarse.reset(); // its grid is not needed any more
-    m_seconds = Normal_orientation::internal::seconds_since(t);
+    this->finish(std::size_t(n));
+    this->m_seconds += Normal_orientation::internal::seconds_since(t);
   }
-
-  /// whether the input normals disagree enough for the pass to be tried
-  bool runs() const { return m_runs; }
 
   /// the pass against the fine orientation in `labels`; returns whether the
   /// coarse signs were installed
@@ -76,18 +71,13 @@ public:
   bool apply(Point_labels& labels, const std::vector<std::uint32_t>& component,
              const std::vector<char>& flip_component, double fine_closedness, const Orient& orient)
   {
-    if (!m_runs)
+    if (!this->runs())
       return false;
     const auto t = std::chrono::steady_clock::now();
-    if (!m_oriented) {
-      m_oriented_cloud = orient(*m_coarse);
-      m_oriented = true;
-    }
-    const bool used =
-      m_coarse->use_coarse_orientation(m_oriented_cloud.first, m_oriented_cloud.second, fine_closedness);
+    const bool used = this->take_coarse(fine_closedness, orient);
     if (used) {
       auto previous = std::move(labels.point_flip);
-      const std::shared_ptr<Coarse_scale> coarse = m_coarse;
+      const std::shared_ptr<Coarse_scale> coarse = this->m_coarse;
       const std::vector<std::uint32_t>* segment_component = &component;
       const std::vector<char>* flips = &flip_component;
       labels.point_flip = [coarse, previous, segment_component, flips](const Swept_record& s, std::uint32_t segment,
@@ -100,25 +90,9 @@ public:
         return int(label) * sign != int(c); // the output label is label * sign, negated when true
       };
     }
-    m_report = m_coarse->report();
-    m_seconds += Normal_orientation::internal::seconds_since(t);
+    this->m_seconds += Normal_orientation::internal::seconds_since(t);
     return used;
   }
-
-  /// what the pass measured and did, with the seconds of all its calls
-  Normal_orientation::internal::Coarse_scale_report report() const
-  {
-    Normal_orientation::internal::Coarse_scale_report r = m_report;
-    r.seconds = m_seconds;
-    return r;
-  }
-
-private:
-  std::shared_ptr<Coarse_scale> m_coarse; ///< (released when the pass does not run)
-  Normal_orientation::internal::Coarse_scale_report m_report;
-  bool m_runs = false, m_oriented = false;
-  std::pair<std::vector<std::array<double, 3>>, double> m_oriented_cloud;
-  double m_seconds = 0.0;
 };
 
 /// The coarse-to-fine pass around the solve (`solve_around_coarse_pass()`):
@@ -126,14 +100,14 @@ private:
 /// the global stage, leaving its summary in `global`; then the pass is tried
 /// (`Stream_coarse_pass`, `orient` as for `Stream_coarse_pass::apply()`).
 /// Adds the pass's figures to `global` and its seconds to `seconds`.
-template <typename Solver, typename Fine, typename Orient>
+template <typename Kernel, typename Solver, typename Fine, typename Orient>
 void coarse_stage(Record_file<Swept_record>& records, double radius, std::uint64_t n, const Solver& solver,
                   const Fine& fine, const Orient& orient, Point_labels& labels,
                   const std::vector<std::uint32_t>& component, const std::vector<char>& flip_component,
                   Global_sign_summary& global, double& seconds)
 {
   auto t = std::chrono::steady_clock::now();
-  Stream_coarse_pass pass(records, radius, n);
+  Stream_coarse_pass<Kernel> pass(records, radius, n);
   seconds += Normal_orientation::internal::seconds_since(t);
   const bool before = Normal_orientation::internal::solve_around_coarse_pass(pass.runs(), solver, fine, [&]() {
     t = std::chrono::steady_clock::now();
