@@ -637,9 +637,26 @@ TEST(Coarse_scale, NoiseWiderThanTheSpacingIsOrientedAtACoarserScale)
   const NO::Orientation_result rc = NO::orient_normals(again, np.solver(counting));
   EXPECT_TRUE(rc.global.coarse_before_solver);
   EXPECT_EQ(*counting.sizes, std::vector<std::size_t>({rc.global.coarse_points}));
+  // the fine field is on the sparse samples: every 7th point
+  EXPECT_EQ(r.global.number_of_samples, (cloud.size() + 6) / 7);
   // only signs change
   for (std::size_t i = 0; i < cloud.size(); ++i)
     EXPECT_TRUE(cloud[i].second == without[i].second || cloud[i].second == -without[i].second);
+}
+
+TEST(Global_sign, GlobalSamplesAreDenseWhereTheNormalsAgree)
+{
+  // n / 4 (dense) or n / 16 points, at least 2^14 (or n), at most 2^16
+  for (bool dense : {false, true}) {
+    EXPECT_EQ(NO::global_samples(0, dense), 0u);
+    EXPECT_EQ(NO::global_samples(4000, dense), 4000u);
+    EXPECT_EQ(NO::global_samples(30000, dense), 16384u);
+    EXPECT_EQ(NO::global_samples(20000000, dense), 65536u);
+  }
+  EXPECT_EQ(NO::global_samples(200000, false), 16384u);
+  EXPECT_EQ(NO::global_samples(200000, true), 50000u);
+  EXPECT_EQ(NO::global_samples(400000, false), 25000u);
+  EXPECT_EQ(NO::global_samples(400000, true), 65536u);
 }
 
 TEST(Coarse_scale, CleanCloudsAreLeftToTheFinePipeline)
@@ -655,6 +672,8 @@ TEST(Coarse_scale, CleanCloudsAreLeftToTheFinePipeline)
   EXPECT_EQ(r.global.coarse_points, 0u);
   EXPECT_FALSE(r.global.coarse_used);
   EXPECT_EQ(clear_wrong(cloud, truth), 0.0);
+  // the field is on the dense samples: every 4th point
+  EXPECT_EQ(r.global.number_of_samples, cloud.size() / 4);
   const std::vector<Sample> s = hollow_ball(20000, rng);
   EXPECT_EQ(orient_and_count(s, NO::Global_orientation::WINDING, 1, &r), 0u);
   EXPECT_GE(r.global.coherence, NO::internal::coarse_coherence_threshold);

@@ -869,6 +869,17 @@ TEST(Streaming_orient_normals, NoiseWiderThanTheSpacingAsInCore)
   }
   std::printf("noisy torus streamed: %.2f%% of the clear normals wrong\n", 100.0 * double(wrong) / double(clear));
   EXPECT_LE(double(wrong), 0.02 * double(clear));
+  // the fine field is on the sparse samples (every 7th record); on the same
+  // torus without noise, on the dense ones (every 4th), and all is right
+  EXPECT_EQ(r.global.number_of_samples, (truth.size() + 6) / 7);
+  Rewindable_source clean{as_records(noisy_cloud(truth, 0.0, 32))};
+  out.clear();
+  const NO::Streaming_result rc = NO::streaming_orient_normals(clean, sink);
+  EXPECT_FALSE(rc.global.coarse_used);
+  EXPECT_EQ(rc.global.number_of_samples, truth.size() / 4);
+  ASSERT_EQ(out.size(), truth.size());
+  for (const NO::Point_record& a : out)
+    EXPECT_GT(Vector(a.normal[0], a.normal[1], a.normal[2]) * truth[a.index].n, 0.0);
 }
 
 TEST(Streaming_orient_normals, GlobalStageAsInCore)

@@ -41,14 +41,18 @@ enum class Global_orientation
 
 /// \ingroup PkgNormalOrientationGlobal
 /// The number of samples the drivers build the global stage's field on, for
-/// a cloud of n points: n / 16, at least 2^14 (or n) and at most 2^16.  They
-/// take every ceil(n / m)-th point of the spatially sorted cloud (in core)
-/// or of the sweep order (streamed).  A subsample much coarser than the
-/// cloud blurs walls thinner than its spacing.
-inline std::uint64_t global_samples(std::uint64_t n)
+/// a cloud of n points: n / 4 where its normals agree at its own spacing
+/// (`dense`), n / 16 where they do not (noise wider than the spacing, which
+/// the coarse-to-fine pass handles), at least 2^14 (or n) and at most 2^16.
+/// They take every ceil(n / m)-th point of the spatially sorted cloud (in
+/// core) or of the sweep order (streamed).  A subsample much coarser than the
+/// cloud blurs walls thinner than its spacing; the noisy normals of a denser
+/// one mislead the field.
+inline std::uint64_t global_samples(std::uint64_t n, bool dense = false)
 {
-  return std::min<std::uint64_t>(n, std::max<std::uint64_t>(std::uint64_t(1) << 14,
-                                                            std::min<std::uint64_t>(n / 16, std::uint64_t(1) << 16)));
+  const std::uint64_t share = n / (dense ? 4 : 16);
+  return std::min<std::uint64_t>(
+    n, std::max<std::uint64_t>(std::uint64_t(1) << 14, std::min<std::uint64_t>(share, std::uint64_t(1) << 16)));
 }
 
 /// \ingroup PkgNormalOrientationGlobal

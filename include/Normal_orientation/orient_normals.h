@@ -436,8 +436,14 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
 
       // 3-5. Solve (with unary terms when there are constraints or priors),
       // give every component its sign, then the global stage.
+      // The field's samples are dense where the input normals agree (the
+      // coarse pass does not run), except on the pass's own coarse cloud.
       std::vector<char> has_unary; // per vertex, with unary terms only
-      auto fine = [&](const auto& the_solver, bool) {
+      constexpr bool coarse_cloud =
+        internal::Is_coarse_cloud_point<typename std::iterator_traits<decltype(points.begin())>::value_type>::value;
+      auto fine = [&](const auto& the_solver, bool, bool dense) {
+        internal::Global_settings global = policies.global;
+        global.dense_samples = dense && !coarse_cloud;
         auto t = std::chrono::steady_clock::now();
         std::fill(labels.begin(), labels.end(), Label(1));
         const Solver_report sr = internal::solve_core<has_constraints || has_prior>(the_solver, graph, weight, label_map,
@@ -466,7 +472,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         if (policies.global.orientation != Global_orientation::NONE) {
           progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
           result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(
-            graph, in.points, in.normals, component, gr.radius, has_unary, moved, policies.global, labels);
+            graph, in.points, in.normals, component, gr.radius, has_unary, moved, global, labels);
           result.seconds.global += result.global.seconds;
         }
       };
@@ -490,7 +496,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         result.global.seconds += coarse.seconds;
         result.seconds.global += coarse.seconds;
       } else {
-        fine(solver, true);
+        fine(solver, true, true);
       }
       result.energy_after = energy(graph, weight, label_map);
       for (std::size_t q = 0; q < n; ++q)

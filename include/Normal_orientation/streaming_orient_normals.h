@@ -231,7 +231,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   Point_labels labels;
   std::vector<char> flip_component;
   Labelled_reader points(records, labels);
-  auto fine = [&](const auto& the_solver, bool with_refinement) {
+  auto fine = [&](const auto& the_solver, bool with_refinement, bool dense) {
     t = Clock::now();
     stage(Stage::SOLVE).report(0, 1);
     solution = solve_segment_graph_stage(segmenter, the_solver, Unary::enabled);
@@ -268,8 +268,10 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
 
     if (global.orientation != Global_orientation::NONE) {
       t = Clock::now();
+      Normal_orientation::internal::Global_settings g = global;
+      g.dense_samples = dense;
       result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component,
-                                                   swept.segment_has_unary, radius, n, global, stage(Stage::GLOBAL));
+                                                   swept.segment_has_unary, radius, n, g, stage(Stage::GLOBAL));
       result.seconds.global += seconds_since(t);
     }
   };
@@ -283,7 +285,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     coarse_stage<Kernel>(records, radius, n, solver, fine, orient_coarse, labels, solution.component, flip_component,
                          result.global, result.seconds.global);
   } else {
-    fine(solver, true);
+    fine(solver, true, true);
   }
   edges.reset(); // removes the edge file
   if (global.orientation != Global_orientation::NONE && labels.point_flip)

@@ -396,9 +396,10 @@ struct Has_starting_solver<Solver, std::void_t<decltype(std::declval<const Solve
 {};
 
 /// The order of the solve and of the coarse-to-fine pass, in both drivers.
-/// `fine(solver, improve)` labels the cloud with `solver` and runs what
-/// follows it up to the global stage (`improve`: with the streamed
-/// refinement); `apply()` tries the pass against that labelling and returns
+/// `fine(solver, improve, dense)` labels the cloud with `solver` and runs
+/// what follows it up to the global stage (`improve`: with the streamed
+/// refinement; `dense`: the field on the dense samples of
+/// `global_samples()`, where the pass does not run); `apply()` tries the pass against that labelling and returns
 /// whether the coarse signs were taken.  Where the pass runs (`pass_runs`)
 /// and `solver` starts from another, the pass is first tried against the
 /// labelling of that start, unimproved: when it is taken, `solver` never
@@ -408,12 +409,12 @@ bool solve_around_coarse_pass(bool pass_runs, const Solver& solver, const Fine& 
 {
   if constexpr (Has_starting_solver<Solver>::value) {
     if (pass_runs) {
-      fine(solver.initial, false);
+      fine(solver.initial, false, false);
       if (apply())
         return true;
     }
   }
-  fine(solver, true);
+  fine(solver, true, !pass_runs);
   if (pass_runs)
     apply();
   return false;

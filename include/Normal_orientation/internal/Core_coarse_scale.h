@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -40,6 +41,19 @@ struct Coarse_cloud_point
 {
   typename Kernel::Point_3 point;
   typename Kernel::Vector_3 normal;
+};
+
+/// Whether `Point` is `Coarse_cloud_point`: the coarse cloud stands for
+/// input normals that disagree at their own spacing, and its global stage
+/// keeps the sparse samples (`global_samples()`).
+template <typename Point>
+struct Is_coarse_cloud_point : std::false_type
+{
+};
+/// \copydoc Is_coarse_cloud_point
+template <typename Kernel>
+struct Is_coarse_cloud_point<Coarse_cloud_point<Kernel>> : std::true_type
+{
 };
 
 /// The position map of a coarse cloud.

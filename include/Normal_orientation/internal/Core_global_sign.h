@@ -221,6 +221,10 @@ struct Global_settings
 {
   Global_orientation orientation = Global_orientation::NONE;
   std::array<double, 3> up = {{0.0, 0.0, 1.0}};
+  /// the field's samples: `global_samples()` with `dense`, where the input
+  /// normals agree at their own spacing (the drivers' fine step, when the
+  /// coarse-to-fine pass does not run)
+  bool dense_samples = false;
   /// the options of `exterior_visibility()`
   Exterior_visibility_options visibility() const
   {
@@ -351,16 +355,17 @@ struct Core_samples
   std::vector<std::uint32_t> component;            ///< their components
 };
 
-/// The samples of `points`, with their areas (`estimate_point_areas()`,
-/// capped by `cap_areas()`).
+/// The samples of `points` (`global_samples()`, `dense` as there), with
+/// their areas (`estimate_point_areas()`, capped by `cap_areas()`).
 template <typename ConcurrencyTag, typename Kernel>
 Core_samples<Kernel> core_samples(const std::vector<typename Kernel::Point_3>& points,
                                   const std::vector<typename Kernel::Vector_3>& normals,
-                                  const std::vector<std::uint32_t>& component, const std::vector<Label>& labels)
+                                  const std::vector<std::uint32_t>& component, const std::vector<Label>& labels,
+                                  bool dense)
 {
   Core_samples<Kernel> s;
   const std::size_t n = points.size();
-  const std::size_t m = std::max<std::size_t>(1, std::size_t(global_samples(n)));
+  const std::size_t m = std::max<std::size_t>(1, std::size_t(global_samples(n, dense)));
   const std::size_t stride = std::max<std::size_t>(1, (n + m - 1) / m);
   s.is_sample.assign(n, 0);
   for (std::size_t i = 0; i < n; i += stride)
@@ -444,7 +449,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = points.size();
   const std::vector<Label> labels_before = labels;
-  Core_samples<Kernel> samples = core_samples<ConcurrencyTag, Kernel>(points, normals, component, labels);
+  Core_samples<Kernel> samples = core_samples<ConcurrencyTag, Kernel>(points, normals, component, labels, settings.dense_samples);
   const std::size_t ns = samples.index.size();
   std::size_t nc = 0;
   for (std::uint32_t c : component)

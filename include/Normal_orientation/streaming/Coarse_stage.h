@@ -96,7 +96,7 @@ public:
 };
 
 /// The coarse-to-fine pass around the solve (`solve_around_coarse_pass()`):
-/// `fine(solver, improve)` solves, refines when `improve`, signs and runs
+/// `fine(solver, improve, dense)` solves, refines when `improve`, signs and runs
 /// the global stage, leaving its summary in `global`; then the pass is tried
 /// (`Stream_coarse_pass`, `orient` as for `Stream_coarse_pass::apply()`).
 /// Adds the pass's figures to `global` and its seconds to `seconds`.

@@ -171,7 +171,7 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
   const auto t0 = std::chrono::steady_clock::now();
   progress.report(0, 4);
-  const std::uint64_t m = std::max<std::uint64_t>(1, global_samples(n));
+  const std::uint64_t m = std::max<std::uint64_t>(1, global_samples(n, settings.dense_samples));
   const std::uint64_t stride = std::max<std::uint64_t>(1, (n + m - 1) / m);
   Global_samples<Kernel> samples = collect_global_samples<Kernel>(points, component, flip_component, stride);
   progress.report(1, 4);
