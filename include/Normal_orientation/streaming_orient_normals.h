@@ -143,6 +143,34 @@ std::uint64_t scan_and_radius_stages(Source& source, const Streaming_settings& s
   return n;
 }
 
+/// The last stages: the output, without the components smaller than
+/// `settings.minimum_component_size`, then one file per kept component when
+/// asked; `segment_size` is per sweep segment.
+template <typename Sink>
+void output_stages(Labelled_reader& points, const Segment_solution& solution, const std::vector<char>& flip_component,
+                   const std::vector<std::uint64_t>& segment_size, const Streaming_settings& settings, Sink& sink,
+                   Component_file_set& component_files, std::uint64_t n, Streaming_result& result)
+{
+  using Normal_orientation::internal::seconds_since;
+  std::vector<std::uint64_t> size(solution.number_of_components, 0);
+  for (std::size_t s = 0; s < segment_size.size(); ++s)
+    size[solution.component[s]] += segment_size[s];
+  const Component_ranking ranking(size, settings.minimum_component_size);
+  result.number_of_dropped_components = ranking.dropped_components;
+  result.number_of_dropped_points = ranking.dropped_points;
+  const Final_signs signs{solution.component, flip_component, ranking};
+  auto t = std::chrono::steady_clock::now();
+  result.number_of_flipped = output_stage(points, signs, sink, n, stage_progress(settings.progress, Stage::OUTPUT));
+  result.seconds.output = seconds_since(t);
+  if (component_files.enabled() && ranking.kept > 0) {
+    t = std::chrono::steady_clock::now();
+    component_files_stage(points, signs, settings.component_files, settings.temporary_directory, component_files, n,
+                          stage_progress(settings.progress, Stage::COMPONENTS));
+    result.seconds.components = seconds_since(t);
+  }
+  result.component_files = component_files.files();
+}
+
 /// The stages, run one after the other (see `streaming_orient_normals()`).
 template <typename ConcurrencyTag, typename Kernel, typename Source, typename Sink, typename FlipCriterion,
           typename Solver, typename SignPolicy, typename Unary>
@@ -291,28 +319,10 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   if (global.orientation != Global_orientation::NONE && labels.point_flip)
     result.energy_after = std::numeric_limits<double>::quiet_NaN(); // (point by point: not measured)
 
-  // 9. Output, without the small components.
-  std::vector<std::uint64_t> size(solution.number_of_components, 0);
-  for (std::size_t s = 0; s < swept.segment_size.size(); ++s)
-    size[solution.component[s]] += swept.segment_size[s];
-  const Component_ranking ranking(size, settings.minimum_component_size);
-  result.number_of_dropped_components = ranking.dropped_components;
-  result.number_of_dropped_points = ranking.dropped_points;
-  const Final_signs signs{solution.component, flip_component, ranking};
+  // 9-10. Output, without the small components, and the component files.
   if (hooks.before_output)
     hooks.before_output(n);
-  t = Clock::now();
-  result.number_of_flipped = output_stage(points, signs, sink, n, stage(Stage::OUTPUT));
-  result.seconds.output = seconds_since(t);
-
-  // 10. One file per kept component.
-  if (component_files.enabled() && ranking.kept > 0) {
-    t = Clock::now();
-    component_files_stage(points, signs, settings.component_files, settings.temporary_directory, component_files, n,
-                          stage(Stage::COMPONENTS));
-    result.seconds.components = seconds_since(t);
-  }
-  result.component_files = component_files.files();
+  output_stages(points, solution, flip_component, swept.segment_size, settings, sink, component_files, n, result);
   component_files.keep();
 }
 
