@@ -399,8 +399,9 @@ struct Has_starting_solver<Solver, std::void_t<decltype(std::declval<const Solve
 /// `fine(solver, improve, dense)` labels the cloud with `solver` and runs
 /// what follows it up to the global stage (`improve`: with the streamed
 /// refinement; `dense`: the field on the dense samples of
-/// `global_samples()`, where the pass does not run); `apply()` tries the pass against that labelling and returns
-/// whether the coarse signs were taken.  Where the pass runs (`pass_runs`)
+/// `global_samples()`, where the pass does not run); `apply()` tries the
+/// pass against that labelling and returns whether the coarse signs were
+/// taken.  Where the pass runs (`pass_runs`)
 /// and `solver` starts from another, the pass is first tried against the
 /// labelling of that start, unimproved: when it is taken, `solver` never
 /// runs on the cloud.  Returns whether that happened.

@@ -48,13 +48,11 @@ struct Coarse_cloud_point
 /// keeps the sparse samples (`global_samples()`).
 template <typename Point>
 struct Is_coarse_cloud_point : std::false_type
-{
-};
+{};
 /// \copydoc Is_coarse_cloud_point
 template <typename Kernel>
 struct Is_coarse_cloud_point<Coarse_cloud_point<Kernel>> : std::true_type
-{
-};
+{};
 
 /// The position map of a coarse cloud.
 template <typename Kernel>

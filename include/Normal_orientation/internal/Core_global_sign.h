@@ -449,7 +449,8 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = points.size();
   const std::vector<Label> labels_before = labels;
-  Core_samples<Kernel> samples = core_samples<ConcurrencyTag, Kernel>(points, normals, component, labels, settings.dense_samples);
+  Core_samples<Kernel> samples =
+    core_samples<ConcurrencyTag, Kernel>(points, normals, component, labels, settings.dense_samples);
   const std::size_t ns = samples.index.size();
   std::size_t nc = 0;
   for (std::uint32_t c : component)

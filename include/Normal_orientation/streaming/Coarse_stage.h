@@ -96,8 +96,9 @@ public:
 };
 
 /// The coarse-to-fine pass around the solve (`solve_around_coarse_pass()`):
-/// `fine(solver, improve, dense)` solves, refines when `improve`, signs and runs
-/// the global stage, leaving its summary in `global`; then the pass is tried
+/// `fine(solver, improve, dense)` solves, refines when `improve`, signs and
+/// runs the global stage (on the dense samples when `dense`), leaving its
+/// summary in `global`; then the pass is tried
 /// (`Stream_coarse_pass`, `orient` as for `Stream_coarse_pass::apply()`).
 /// Adds the pass's figures to `global` and its seconds to `seconds`.
 template <typename Kernel, typename Solver, typename Fine, typename Orient>
