@@ -21,6 +21,7 @@
 namespace {
 
 using Normal_orientation::benchmark::Xyz_row;
+using Normal_orientation::benchmark::check_same_points;
 
 /// Prints the usage message to `out`.
 void print_usage(std::FILE* out)
@@ -49,53 +50,6 @@ struct Score
 double percent(std::size_t part, std::size_t whole)
 {
   return whole == 0 ? 0.0 : 100.0 * double(part) / double(whole);
-}
-
-/// Returns the bounding-box diagonal of the points of `rows`.
-double bbox_diagonal(const std::vector<Xyz_row>& rows)
-{
-  if(rows.empty())
-    return 0.0;
-  double lo[3] = {rows[0][0], rows[0][1], rows[0][2]};
-  double hi[3] = {lo[0], lo[1], lo[2]};
-  for(const Xyz_row& r : rows)
-    for(int c = 0; c < 3; ++c)
-    {
-      lo[c] = std::fmin(lo[c], r[c]);
-      hi[c] = std::fmax(hi[c], r[c]);
-    }
-  return std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                   (hi[2] - lo[2]) * (hi[2] - lo[2]));
-}
-
-/**
- * Checks that `oriented` has the points of `truth` in the same order, each within
- * `1e-5 x` the truth's bounding-box diagonal (both files may be written with 9 digits).
- * Returns an empty string on success, else the reason.
- */
-std::string check_same_points(const std::vector<Xyz_row>& oriented, const std::vector<Xyz_row>& truth)
-{
-  if(oriented.size() != truth.size())
-    return "the oriented cloud has " + std::to_string(oriented.size()) + " points, the truth " +
-           std::to_string(truth.size()) + ": not the same cloud";
-  const double tolerance = 1e-5 * bbox_diagonal(truth);
-  for(std::size_t i = 0; i < truth.size(); ++i)
-  {
-    const double dx = oriented[i][0] - truth[i][0];
-    const double dy = oriented[i][1] - truth[i][1];
-    const double dz = oriented[i][2] - truth[i][2];
-    const double d = std::sqrt(dx * dx + dy * dy + dz * dz);
-    if(!(d <= tolerance))
-    {
-      char message[256];
-      std::snprintf(message, sizeof message,
-                    "point %zu (counted from 0) is %.3g away from the truth's (tolerance %.3g): "
-                    "the files do not hold the same points in the same order",
-                    i, d, tolerance);
-      return message;
-    }
-  }
-  return std::string();
 }
 
 /// Scores `oriented` against `truth` (same size, checked before).
