@@ -229,6 +229,31 @@ inline std::string check_same_points(const std::vector<Xyz_row>& oriented, const
   return std::string();
 }
 
+/**
+ * \brief Reads an oriented cloud and its truth (`.xyz` files, as `read_xyz_rows()`) and checks
+ * that the truth has points and that both hold them in the same order (`check_same_points()`).
+ *
+ * \return `true` on success; on failure `error` explains why.
+ */
+inline bool read_oriented_and_truth(const std::string& oriented_path, const std::string& truth_path,
+                                    std::vector<Xyz_row>& oriented, std::vector<Xyz_row>& truth, std::string& error)
+{
+  if(!read_xyz_rows(oriented_path, oriented, error) || !read_xyz_rows(truth_path, truth, error))
+    return false;
+  if(truth.empty())
+  {
+    error = "'" + truth_path + "' holds no point";
+    return false;
+  }
+  error = check_same_points(oriented, truth);
+  if(!error.empty())
+  {
+    error = "'" + oriented_path + "' against '" + truth_path + "': " + error;
+    return false;
+  }
+  return true;
+}
+
 } // namespace benchmark
 } // namespace Normal_orientation
 

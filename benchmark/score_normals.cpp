@@ -21,7 +21,6 @@
 namespace {
 
 using Normal_orientation::benchmark::Xyz_row;
-using Normal_orientation::benchmark::check_same_points;
 
 /// Prints the usage message to `out`.
 void print_usage(std::FILE* out)
@@ -116,22 +115,9 @@ int main(int argc, char** argv)
   const auto start = std::chrono::steady_clock::now();
   std::vector<Xyz_row> oriented, truth;
   std::string error;
-  if(!Normal_orientation::benchmark::read_xyz_rows(positional[0], oriented, error) ||
-     !Normal_orientation::benchmark::read_xyz_rows(positional[1], truth, error))
+  if(!Normal_orientation::benchmark::read_oriented_and_truth(positional[0], positional[1], oriented, truth, error))
   {
     std::fprintf(stderr, "score_normals: %s\n", error.c_str());
-    return EXIT_FAILURE;
-  }
-  if(truth.empty())
-  {
-    std::fprintf(stderr, "score_normals: '%s' holds no point\n", positional[1].c_str());
-    return EXIT_FAILURE;
-  }
-  error = check_same_points(oriented, truth);
-  if(!error.empty())
-  {
-    std::fprintf(stderr, "score_normals: '%s' against '%s': %s\n", positional[0].c_str(), positional[1].c_str(),
-                 error.c_str());
     return EXIT_FAILURE;
   }
   const Score s = score(oriented, truth);

@@ -97,22 +97,9 @@ int main(int argc, char** argv)
 
   std::vector<Xyz_row> oriented, truth;
   std::string error;
-  if(!Normal_orientation::benchmark::read_xyz_rows(positional[0], oriented, error) ||
-     !Normal_orientation::benchmark::read_xyz_rows(positional[1], truth, error))
+  if(!Normal_orientation::benchmark::read_oriented_and_truth(positional[0], positional[1], oriented, truth, error))
   {
     std::fprintf(stderr, "winding_energy: %s\n", error.c_str());
-    return EXIT_FAILURE;
-  }
-  if(truth.empty())
-  {
-    std::fprintf(stderr, "winding_energy: '%s' holds no point\n", positional[1].c_str());
-    return EXIT_FAILURE;
-  }
-  error = Normal_orientation::benchmark::check_same_points(oriented, truth);
-  if(!error.empty())
-  {
-    std::fprintf(stderr, "winding_energy: '%s' against '%s': %s\n", positional[0].c_str(), positional[1].c_str(),
-                 error.c_str());
     return EXIT_FAILURE;
   }
 
