@@ -488,13 +488,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         const bool before = internal::solve_around_coarse_pass(pass.runs(), solver, fine, [&]() {
           return pass.apply(labels, result.global.closedness, orient_coarse);
         });
-        const internal::Coarse_scale_report coarse = pass.report();
-        result.global.coarse_before_solver = before;
-        result.global.coherence = coarse.coherence;
-        result.global.coarse_points = coarse.coarse_points;
-        result.global.coarse_used = coarse.used;
-        result.global.seconds += coarse.seconds;
-        result.seconds.global += coarse.seconds;
+        pass.add_report(before, result.global, result.seconds.global);
       } else {
         fine(solver, true, true);
       }

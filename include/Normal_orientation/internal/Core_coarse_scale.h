@@ -12,6 +12,7 @@
 
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Orientation_problem.h>
+#include <Normal_orientation/Orientation_result.h>
 #include <Normal_orientation/internal/Coarse_scale.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/internal/Parallel.h>
@@ -138,6 +139,19 @@ public:
     Coarse_scale_report r = m_report;
     r.seconds = m_seconds;
     return r;
+  }
+
+  /// Adds what the pass measured and did to the global stage's summary
+  /// `global` (`before`: the coarse signs were taken before the solver), and
+  /// its seconds to `global.seconds` and to `seconds`.
+  void add_report(bool before, Global_sign_summary& global, double& seconds) const
+  {
+    global.coarse_before_solver = before;
+    global.coherence = m_report.coherence;
+    global.coarse_points = m_report.coarse_points;
+    global.coarse_used = m_report.used;
+    global.seconds += m_seconds;
+    seconds += m_seconds;
   }
 
 protected:

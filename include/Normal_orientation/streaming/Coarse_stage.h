@@ -107,21 +107,11 @@ void coarse_stage(Record_file<Swept_record>& records, double radius, std::uint64
                   const std::vector<std::uint32_t>& component, const std::vector<char>& flip_component,
                   Global_sign_summary& global, double& seconds)
 {
-  auto t = std::chrono::steady_clock::now();
   Stream_coarse_pass<Kernel> pass(records, radius, n);
-  seconds += Normal_orientation::internal::seconds_since(t);
   const bool before = Normal_orientation::internal::solve_around_coarse_pass(pass.runs(), solver, fine, [&]() {
-    t = std::chrono::steady_clock::now();
-    const bool used = pass.apply(labels, component, flip_component, global.closedness, orient);
-    seconds += Normal_orientation::internal::seconds_since(t);
-    return used;
+    return pass.apply(labels, component, flip_component, global.closedness, orient);
   });
-  const Normal_orientation::internal::Coarse_scale_report coarse = pass.report();
-  global.coarse_before_solver = before;
-  global.coherence = coarse.coherence;
-  global.coarse_points = coarse.coarse_points;
-  global.coarse_used = coarse.used;
-  global.seconds += coarse.seconds;
+  pass.add_report(before, global, seconds);
 }
 
 } // namespace internal
