@@ -749,6 +749,59 @@ TEST(Global_sign, PatchesSeparateLayersCloserThanTheSpacing)
     EXPECT_EQ(apart[i] == apart[0], !moved[i]) << i;
 }
 
+TEST(Global_sign, PatchesAreTheSameForAnyNumberOfThreads)
+{
+  // A torus with random labels, cells of a few spacings and every 7th point
+  // a sample (so that patches without one join a neighbour): the parallel
+  // edge tests give the sequential patches, and every edge that the rule
+  // joins (same cell, same sheet) has both ends in one patch.
+  std::mt19937_64 rng(43);
+  const std::vector<Sample> truth = torus(20000, 1.0, 0.3, rng);
+  std::vector<Point> points;
+  std::vector<Vector> normals;
+  for (const Sample& s : truth) {
+    points.push_back(s.p);
+    normals.push_back(s.n);
+  }
+  NO::Neighbor_graph graph;
+  const NO::Neighbor_graph_report report = NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(
+    points, normals, 12, 0.0, NO::Hoppe_criterion(), graph);
+  std::vector<NO::Label> labels(points.size());
+  std::vector<char> is_sample(points.size(), 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    labels[i] = NO::Label(rng() % 8 == 0 ? -1 : 1);
+    is_sample[i] = i % 7 == 0;
+  }
+  const std::vector<float> slopes = NO::internal::edge_slopes<Kernel>(graph, points, normals);
+  const double cell = 4.0 * report.radius;
+  std::size_t sequential = 0, parallel = 0;
+  const std::vector<std::uint32_t> a = NO::internal::build_patches<Kernel, CGAL::Sequential_tag>(
+    graph, points, normals, labels, {}, cell, slopes, NO::internal::sheet_slope, is_sample, sequential);
+  const std::vector<std::uint32_t> b = NO::internal::build_patches<Kernel, CGAL::Parallel_tag>(
+    graph, points, normals, labels, {}, cell, slopes, NO::internal::sheet_slope, is_sample, parallel);
+  EXPECT_GT(sequential, 20u);
+  EXPECT_EQ(sequential, parallel);
+  EXPECT_EQ(a, b);
+  double lo[3] = {points[0].x(), points[0].y(), points[0].z()}; // the cells' grid starts at the lowest corner
+  for (const Point& p : points)
+    for (int c = 0; c < 3; ++c)
+      lo[c] = std::min(lo[c], p[c]);
+  std::size_t joined = 0, e = 0;
+  for (auto edge : boost::make_iterator_range(edges(graph))) {
+    const std::size_t i = source(edge, graph), j = target(edge, graph);
+    const Vector mi = labels[i] < 0 ? -normals[i] : normals[i], mj = labels[j] < 0 ? -normals[j] : normals[j];
+    bool same_cell = true;
+    for (int c = 0; c < 3; ++c)
+      same_cell = same_cell && std::floor((points[i][c] - lo[c]) / cell) == std::floor((points[j][c] - lo[c]) / cell);
+    if (same_cell && NO::internal::same_sheet(mi, mj, slopes[e], NO::internal::sheet_slope)) {
+      ++joined;
+      EXPECT_EQ(a[i], a[j]) << i << " " << j;
+    }
+    ++e;
+  }
+  EXPECT_GT(joined, num_edges(graph) / 2);
+}
+
 TEST(Global_sign, PatchSlopeIsTheMedianEdgeSlopeWithinItsBounds)
 {
   // patch_slope() takes the median of every 16th edge: close to the median of

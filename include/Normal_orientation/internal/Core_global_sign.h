@@ -14,6 +14,7 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Signed_union_find.h>
 #include <Normal_orientation/Winding_number_field.h>
+#include <Normal_orientation/internal/Parallel.h>
 
 #include <algorithm>
 #include <array>
@@ -22,6 +23,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <numeric>
+#include <utility>
 #include <vector>
 
 /// \cond SKIP_IN_MANUAL
@@ -125,13 +127,16 @@ bool same_sheet(const Vector& mi, const Vector& mj, float slope, double max_slop
 /// (`moved`, per point; empty: no start); then patches without a sample join
 /// a neighbouring patch through an edge whose oriented normals agree.
 /// Returns the patch of every point (zero normals get a patch of their own).
-template <typename Kernel>
+/// The tests of the edges run in parallel, the unions in the order of the
+/// edges: the patches are the same for any number of threads.
+template <typename Kernel, typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
 std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                                          const std::vector<typename Kernel::Vector_3>& normals,
                                          const std::vector<Label>& labels, const std::vector<char>& moved,
                                          double cell, const std::vector<float>& slopes, double max_slope,
                                          const std::vector<char>& is_sample, std::size_t& number_of_patches)
 {
+  typedef Signed_union_find::Index Index;
   const std::size_t n = points.size();
   double lo[3] = {0, 0, 0};
   for (int c = 0; c < 3 && n > 0; ++c) {
@@ -141,31 +146,56 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std:
   }
   std::vector<std::uint64_t> cells(n, 0);
   if (cell > 0.0)
-    for (std::size_t i = 0; i < n; ++i)
-      for (int c = 0; c < 3; ++c)
-        cells[i] = (cells[i] << 21) | (std::uint64_t((CGAL::to_double(points[i][c]) - lo[c]) / cell) & 0x1FFFFF);
+    parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i)
+        for (int c = 0; c < 3; ++c)
+          cells[i] = (cells[i] << 21) | (std::uint64_t((CGAL::to_double(points[i][c]) - lo[c]) / cell) & 0x1FFFFF);
+    });
   auto oriented = [&](std::size_t i) { return labels[i] < 0 ? -normals[i] : normals[i]; };
   auto same_move = [&](std::size_t i, std::size_t j) { return moved.empty() || moved[i] == moved[j]; };
+  // Per edge (in the order of edges(graph), which is that of the sources'
+  // out-edges): 1 when it joins its ends into one patch.
+  std::vector<unsigned char> joins(num_edges(graph), 0);
+  auto for_each_edge = [&](const auto& f) {
+    parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+      typename boost::graph_traits<Neighbor_graph>::out_edge_iterator it, end;
+      for (std::size_t i = b; i < e; ++i)
+        for (boost::tie(it, end) = out_edges(Index(i), graph); it != end; ++it)
+          f(i, std::size_t(target(*it, graph)), std::size_t(get(boost::edge_index, graph, *it)));
+    });
+  };
+  for_each_edge([&](std::size_t i, std::size_t j, std::size_t e) {
+    joins[e] = cells[i] == cells[j] && same_move(i, j) && same_sheet(oriented(i), oriented(j), slopes[e], max_slope);
+  });
   Signed_union_find uf(n);
   typename boost::graph_traits<Neighbor_graph>::edge_iterator it, end;
   std::size_t e = 0;
-  for (boost::tie(it, end) = edges(graph); it != end; ++it, ++e) {
-    const std::size_t i = source(*it, graph), j = target(*it, graph);
-    if (cells[i] == cells[j] && same_move(i, j) && same_sheet(oriented(i), oriented(j), slopes[e], max_slope))
-      uf.unite(Signed_union_find::Index(i), Signed_union_find::Index(j));
-  }
+  for (boost::tie(it, end) = edges(graph); it != end; ++it, ++e)
+    if (joins[e])
+      uf.unite(Index(source(*it, graph)), Index(target(*it, graph)));
   // Patches without a sample join a sampled neighbour (a few sweeps reach
-  // patches two or three steps away).
+  // patches two or three steps away), through the edges between two patches
+  // whose oriented normals agree (no other edge can ever join two).
+  std::vector<Index> root(n);
   std::vector<char> sampled(n, 0);
-  for (std::size_t i = 0; i < n; ++i)
+  for (std::size_t i = 0; i < n; ++i) {
+    root[i] = uf.find(Index(i));
     if (is_sample[i])
-      sampled[uf.find(Signed_union_find::Index(i))] = 1;
+      sampled[root[i]] = 1;
+  }
+  for_each_edge([&](std::size_t i, std::size_t j, std::size_t e) {
+    joins[e] = root[i] != root[j] && oriented(i) * oriented(j) > 0.0;
+  });
+  std::vector<std::pair<Index, Index>> between;
+  e = 0;
+  for (boost::tie(it, end) = edges(graph); it != end; ++it, ++e)
+    if (joins[e])
+      between.emplace_back(Index(source(*it, graph)), Index(target(*it, graph)));
   for (int sweep = 0; sweep < 4; ++sweep) {
     bool changed = false;
-    for (boost::tie(it, end) = edges(graph); it != end; ++it) {
-      const std::size_t i = source(*it, graph), j = target(*it, graph);
-      const auto ri = uf.find(Signed_union_find::Index(i)), rj = uf.find(Signed_union_find::Index(j));
-      if (ri == rj || sampled[ri] == sampled[rj] || oriented(i) * oriented(j) <= 0.0)
+    for (const auto& ij : between) {
+      const Index ri = uf.find(ij.first), rj = uf.find(ij.second);
+      if (ri == rj || sampled[ri] == sampled[rj])
         continue;
       uf.unite(ri, rj);
       sampled[uf.find(ri)] = 1;
@@ -178,7 +208,7 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std:
   std::vector<std::uint32_t> id(n, unset), patch(n);
   number_of_patches = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const auto r = uf.find(Signed_union_find::Index(i));
+    const auto r = uf.find(Index(i));
     if (id[r] == unset)
       id[r] = std::uint32_t(number_of_patches++);
     patch[i] = id[r];
@@ -408,8 +438,8 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
     std::size_t np = reuse ? number_of_sheets : 0;
     const std::vector<std::uint32_t> patch =
       reuse ? sheets
-            : build_patches<Kernel>(graph, points, normals, labels, moved, cell_radii * radius, slopes, slope,
-                                    samples.is_sample, np);
+            : build_patches<Kernel, ConcurrencyTag>(graph, points, normals, labels, moved, cell_radii * radius,
+                                                    slopes, slope, samples.is_sample, np);
     std::vector<std::uint32_t> spatch;
     for (std::uint32_t i : samples.index)
       spatch.push_back(patch[i]);
@@ -463,8 +493,8 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   // 1. Exterior visibility.
   std::size_t number_of_sheets = 0;
   const std::vector<std::uint32_t> sheet =
-    build_patches<Kernel>(graph, points, normals, labels, moved, 0.0, slopes, sheet_slope, samples.is_sample,
-                          number_of_sheets);
+    build_patches<Kernel, ConcurrencyTag>(graph, points, normals, labels, moved, 0.0, slopes, sheet_slope,
+                                          samples.is_sample, number_of_sheets);
   std::vector<std::uint32_t> sample_sheet(ns);
   for (std::size_t t = 0; t < ns; ++t)
     sample_sheet[t] = sheet[samples.index[t]];
