@@ -78,19 +78,30 @@ constexpr double sheet_slope = 0.5;
 /// about 8.6 degrees from both tangent planes.
 constexpr double patch_slope_floor = 0.15;
 
+/// Calls `f(i, j, e)` for every edge (i, j) of `graph`, e its rank in the
+/// order of `edges(graph)` (that of the sources' out-edges), in parallel
+/// over the sources: `f` may write to slot e of a per-edge array.
+template <typename ConcurrencyTag, typename Function>
+void for_each_edge_in_parallel(const Neighbor_graph& graph, const Function& f)
+{
+  parallel_chunks<ConcurrencyTag>(std::size_t(num_vertices(graph)), [&](std::size_t b, std::size_t e) {
+    typename boost::graph_traits<Neighbor_graph>::out_edge_iterator it, end;
+    for (std::size_t i = b; i < e; ++i)
+      for (boost::tie(it, end) = out_edges(std::uint32_t(i), graph); it != end; ++it)
+        f(i, std::size_t(target(*it, graph)), std::size_t(get(boost::edge_index, graph, *it)));
+  });
+}
+
 /// `edge_slope()` of every edge of `graph`, in the order of `edges(graph)`,
 /// with the unoriented normals.
-template <typename Kernel>
+template <typename Kernel, typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
 std::vector<float> edge_slopes(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                                const std::vector<typename Kernel::Vector_3>& normals)
 {
-  std::vector<float> slope;
-  slope.reserve(num_edges(graph));
-  typename boost::graph_traits<Neighbor_graph>::edge_iterator it, end;
-  for (boost::tie(it, end) = edges(graph); it != end; ++it) {
-    const std::size_t i = source(*it, graph), j = target(*it, graph);
-    slope.push_back(float(edge_slope(points[i], points[j], normals[i], normals[j])));
-  }
+  std::vector<float> slope(num_edges(graph));
+  for_each_edge_in_parallel<ConcurrencyTag>(graph, [&](std::size_t i, std::size_t j, std::size_t e) {
+    slope[e] = float(edge_slope(points[i], points[j], normals[i], normals[j]));
+  });
   return slope;
 }
 
@@ -156,15 +167,7 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std:
   // Per edge (in the order of edges(graph), which is that of the sources'
   // out-edges): 1 when it joins its ends into one patch.
   std::vector<unsigned char> joins(num_edges(graph), 0);
-  auto for_each_edge = [&](const auto& f) {
-    parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
-      typename boost::graph_traits<Neighbor_graph>::out_edge_iterator it, end;
-      for (std::size_t i = b; i < e; ++i)
-        for (boost::tie(it, end) = out_edges(Index(i), graph); it != end; ++it)
-          f(i, std::size_t(target(*it, graph)), std::size_t(get(boost::edge_index, graph, *it)));
-    });
-  };
-  for_each_edge([&](std::size_t i, std::size_t j, std::size_t e) {
+  for_each_edge_in_parallel<ConcurrencyTag>(graph, [&](std::size_t i, std::size_t j, std::size_t e) {
     joins[e] = cells[i] == cells[j] && same_move(i, j) && same_sheet(oriented(i), oriented(j), slopes[e], max_slope);
   });
   Signed_union_find uf(n);
@@ -183,7 +186,7 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std:
     if (is_sample[i])
       sampled[root[i]] = 1;
   }
-  for_each_edge([&](std::size_t i, std::size_t j, std::size_t e) {
+  for_each_edge_in_parallel<ConcurrencyTag>(graph, [&](std::size_t i, std::size_t j, std::size_t e) {
     joins[e] = root[i] != root[j] && oriented(i) * oriented(j) > 0.0;
   });
   std::vector<std::pair<Index, Index>> between;
@@ -489,7 +492,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   for (std::size_t i = 0; i < has_unary.size(); ++i)
     if (has_unary[i])
       component_fixed[component[i]] = 1;
-  const std::vector<float> slopes = edge_slopes<Kernel>(graph, points, normals);
+  const std::vector<float> slopes = edge_slopes<Kernel, ConcurrencyTag>(graph, points, normals);
   // 1. Exterior visibility.
   std::size_t number_of_sheets = 0;
   const std::vector<std::uint32_t> sheet =
