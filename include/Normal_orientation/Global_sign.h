@@ -69,13 +69,18 @@ struct Global_sign_options
   /// a patch is negated only when that lowers the energy by at least this
   /// much per unit of its area: smaller changes are within what noise and
   /// sampling make of w.  (The first-order decrease bounds the exact one,
-  /// so only the patches whose first-order decrease reaches it are tried.)
+  /// so only the patches whose first-order decrease, as screened with
+  /// `screening_opening_ratio`, reaches it are tried.)
   double minimum_decrease = 0.3;
   /// the most rounds of patch flips
   unsigned int maximum_rounds = 8;
   /// the patches whose exact change of energy is computed per round (those
   /// with the largest first-order decrease)
   std::size_t candidates_per_round = 32;
+  /// the opening ratio of the first-order decreases
+  /// (`Winding_number_field::moment_derivatives()`), smaller than the
+  /// field's: they only choose the candidates, whose exact changes decide
+  double screening_opening_ratio = 1.2;
 };
 
 /// \ingroup PkgNormalOrientationGlobal
@@ -160,17 +165,18 @@ double winding_energy(const Field& field, const std::vector<Point>& points, cons
 }
 
 /// Per patch, the first-order decrease of E from negating it, divided by
-/// its area: 4 g_P / A_P with g_P = sum_j a_j (w_j - 1/2) w_P(p_j).
+/// its area: 4 g_P / A_P with g_P = sum_j a_j (w_j - 1/2) w_P(p_j), by the
+/// moment derivatives of `field` with the opening ratio `opening_ratio`.
 template <typename ConcurrencyTag, typename Field>
 std::vector<double> patch_gains(Field& field, const std::vector<double>& areas, const std::vector<double>& w,
-                                const std::vector<std::vector<std::uint32_t>>& members)
+                                const std::vector<std::vector<std::uint32_t>>& members, double opening_ratio)
 {
   const std::size_t n = w.size();
   std::vector<double> weight(n);
   for (std::size_t j = 0; j < n; ++j)
     weight[j] = areas[j] * (w[j] - 0.5);
   std::vector<typename Field::Vector_3> v;
-  field.template moment_derivatives<ConcurrencyTag>(weight, v);
+  field.template moment_derivatives<ConcurrencyTag>(weight, v, opening_ratio);
   std::vector<double> gain(members.size(), 0.0);
   for (std::size_t P = 0; P < members.size(); ++P) {
     double g = 0.0, a = 0.0;
@@ -299,7 +305,8 @@ bool Winding_patch_signs<Kernel>::round(const std::vector<std::vector<std::uint3
                                         const Global_sign_options& options)
 {
   const std::size_t n = m_points.size(), np = members.size();
-  const std::vector<double> gain = internal::patch_gains<ConcurrencyTag>(m_field, m_areas, m_w, members);
+  const std::vector<double> gain =
+    internal::patch_gains<ConcurrencyTag>(m_field, m_areas, m_w, members, options.screening_opening_ratio);
   std::vector<std::uint32_t> candidates;
   for (std::uint32_t P = 0; P < np; ++P)
     if ((fixed.empty() || !fixed[P]) && !members[P].empty() && gain[P] >= options.minimum_decrease)

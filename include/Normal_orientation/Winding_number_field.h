@@ -451,13 +451,25 @@ public:
   ///   v_i = 1/(4 pi) sum_j c_j (p_i - p_j) / (|p_i - p_j|^2 + eps_i^2)^(3/2),
   ///
   /// by a treecode over the same tree (charge sums and their first
-  /// moments, opened with the same ratio).  So the part of J due to a
-  /// set of points P is sum_{i in P} `moment(i)` . v_i, and negating P
-  /// changes J by -2 times that: one pass gives the effect on J of
-  /// negating every patch.  Deterministic for any number of threads.
+  /// moments, opened with the field's `opening_ratio()`, or with
+  /// `opening_ratio` when given: a smaller one is cheaper and coarser).
+  /// So the part of J due to a set of points P is sum_{i in P}
+  /// `moment(i)` . v_i, and negating P changes J by -2 times that: one pass
+  /// gives the effect on J of negating every patch.  Deterministic for any
+  /// number of threads.
   /// \tparam ConcurrencyTag `CGAL::Parallel_tag` or `CGAL::Sequential_tag`
+  /// \throw std::invalid_argument when the weights are not one finite value
+  ///        per point or `opening_ratio` is not finite and > 0
   template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
   void moment_derivatives(const std::vector<double>& weights, std::vector<Vector_3>& derivatives)
+  {
+    moment_derivatives<ConcurrencyTag>(weights, derivatives, beta_);
+  }
+
+  /// `moment_derivatives()` with the opening ratio `opening_ratio`
+  template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
+  void moment_derivatives(const std::vector<double>& weights, std::vector<Vector_3>& derivatives,
+                          double opening_ratio)
   {
     const std::size_t n = size();
     if (weights.size() != n)
@@ -465,9 +477,11 @@ public:
     for (double c : weights)
       if (!std::isfinite(c))
         throw std::invalid_argument("Winding_number_field::moment_derivatives: a weight is not finite");
+    if (!(opening_ratio > 0.0) || !std::isfinite(opening_ratio))
+      throw std::invalid_argument("Winding_number_field::moment_derivatives: the opening ratio must be finite and > 0");
     tree_.set_charges(weights);
     derivatives.assign(n, Vector_3(0, 0, 0));
-    const double beta2 = beta_ * beta_, f2 = factor_ * factor_, s = inv_4pi();
+    const double beta2 = opening_ratio * opening_ratio, f2 = factor_ * factor_, s = inv_4pi();
     const auto& samples = tree_.samples();
     internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
       for (std::size_t t = b; t < e; ++t) { // in tree order: coherent
