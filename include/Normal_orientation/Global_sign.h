@@ -97,10 +97,15 @@ struct Global_sign_options
 ///   E(s) = sum_j a_j (w_s(p_j) - 1/2)^2
 ///
 /// over the signs s_P of the patches, with w_s = sum_P s_P w_P linear in
-/// them.  Rounds: w at every sample (treecode), the first-order change of E
-/// for negating every patch at once (`Winding_number_field::moment_derivatives()`),
-/// then the patches whose negation lowers E most are negated together and
-/// kept if E really fell, halving the set until it does.  Then the
+/// them.  Rounds: w at every sample (treecode); the first-order decrease of
+/// E for negating each patch, all in one pass
+/// (`Winding_number_field::moment_derivatives()` with the coarser
+/// `screening_opening_ratio`); the exact change, from its own field, for
+/// each of the `candidates_per_round` patches with the largest one; then,
+/// best first, every candidate whose exact decrease reaches
+/// `minimum_decrease` per unit of its area joins the patches to negate
+/// while their joint change (exact: E is quadratic in the signs) stays a
+/// decrease.  Rounds stop when none joins.  Then the
 /// components decide: where at least `closed_fraction` of a component's
 /// area has |w - 1/2| <= `agreement_tolerance`, the component is closed and
 /// keeps the stage's signs; elsewhere (an open scan, a lone sheet) its
