@@ -141,7 +141,8 @@ bool same_sheet(const Vector& mi, const Vector& mj, float slope, double max_slop
 /// The tests of the edges run in parallel, the unions in the order of the
 /// edges: the patches are the same for any number of threads.
 template <typename Kernel, typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
-std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
+std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph,
+                                         const std::vector<typename Kernel::Point_3>& points,
                                          const std::vector<typename Kernel::Vector_3>& normals,
                                          const std::vector<Label>& labels, const std::vector<char>& moved,
                                          double cell, const std::vector<float>& slopes, double max_slope,
