@@ -816,6 +816,51 @@ TEST(Global_sign, PatchesAreTheSameForAnyNumberOfThreads)
   EXPECT_GT(joined, num_edges(graph) / 4);
 }
 
+TEST(Global_sign, BlockwiseUnionsGiveTheSetsOfUnitingEveryEdgeInOrder)
+{
+  // Random joining edges on a torus's graph: uniting them block by block (in
+  // parallel, then the edges between blocks) gives the sets of uniting them
+  // one by one, for blocks smaller and larger than the cloud.
+  std::mt19937_64 rng(47);
+  std::vector<Point> points;
+  std::vector<Vector> normals;
+  split_cloud(NO::test::unoriented(torus(20000, 1.0, 0.3, rng), rng), points, normals);
+  NO::Neighbor_graph graph;
+  NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(points, normals, 12, 0.0, NO::Hoppe_criterion(), graph);
+  std::vector<unsigned char> joins(num_edges(graph));
+  for (unsigned char& j : joins)
+    j = rng() % 8 == 0; // one edge in eight: thousands of sets, many spanning blocks
+  auto canonical = [&](NO::Signed_union_find& uf) { // each point's set, numbered by its first point
+    std::vector<std::uint32_t> id(points.size(), ~0u), set(points.size());
+    std::uint32_t next = 0;
+    for (std::uint32_t i = 0; i < points.size(); ++i) {
+      const std::uint32_t r = uf.find(i);
+      if (id[r] == ~0u)
+        id[r] = next++;
+      set[i] = id[r];
+    }
+    return set;
+  };
+  NO::Signed_union_find one_by_one(points.size());
+  std::size_t e = 0;
+  for (auto edge : boost::make_iterator_range(edges(graph)))
+    if (joins[e++])
+      one_by_one.unite(std::uint32_t(source(edge, graph)), std::uint32_t(target(edge, graph)));
+  const std::vector<std::uint32_t> expected = canonical(one_by_one);
+  std::size_t sets = 0;
+  for (std::uint32_t s : expected)
+    sets = std::max<std::size_t>(sets, s + 1);
+  EXPECT_GT(sets, 100u);
+  EXPECT_LT(sets, points.size() / 2);
+  for (std::size_t block : {std::size_t(1), std::size_t(997), std::size_t(1) << 16}) {
+    NO::Signed_union_find sequential(points.size()), parallel(points.size());
+    NO::internal::unite_joined_edges<CGAL::Sequential_tag>(graph, joins, sequential, block);
+    NO::internal::unite_joined_edges<CGAL::Parallel_tag>(graph, joins, parallel, block);
+    EXPECT_EQ(canonical(sequential), expected) << block;
+    EXPECT_EQ(canonical(parallel), expected) << block;
+  }
+}
+
 TEST(Global_sign, PatchSlopeIsTheMedianEdgeSlopeWithinItsBounds)
 {
   // patch_slope() takes the median of every 16th edge: close to the median of

@@ -131,6 +131,38 @@ bool same_sheet(const Vector& mi, const Vector& mj, float slope, double max_slop
   return CGAL::to_double(mi * mj) >= 0.5 && double(slope) <= max_slope;
 }
 
+/// Unites the ends of every edge `e` of `graph` with `joins[e]` in `uf`
+/// (singletons on entry).  The points are cut into blocks of `block`
+/// consecutive indices: the edges inside one block are united in parallel
+/// over the blocks (each block's trees hold only its own points), then the
+/// edges between blocks sequentially.  The sets are those of uniting every
+/// edge in order, for any number of threads; only their roots may differ.
+template <typename ConcurrencyTag>
+void unite_joined_edges(const Neighbor_graph& graph, const std::vector<unsigned char>& joins,
+                        Signed_union_find& uf, std::size_t block = std::size_t(1) << 16)
+{
+  typedef Signed_union_find::Index Index;
+  const std::size_t n = std::size_t(num_vertices(graph)), blocks = (n + block - 1) / block;
+  std::vector<std::vector<std::pair<Index, Index>>> across(blocks);
+  parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
+    typename boost::graph_traits<Neighbor_graph>::out_edge_iterator it, end;
+    for (std::size_t b = bb; b < be; ++b)
+      for (std::size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
+        for (boost::tie(it, end) = out_edges(Index(i), graph); it != end; ++it) {
+          const Index j = Index(target(*it, graph));
+          if (!joins[std::size_t(get(boost::edge_index, graph, *it))])
+            continue;
+          if (j / block == b)
+            uf.unite(Index(i), j);
+          else
+            across[b].emplace_back(Index(i), j);
+        }
+  }, 1);
+  for (const auto& pairs : across)
+    for (const auto& ij : pairs)
+      uf.unite(ij.first, ij.second);
+}
+
 /// Patches of the labelled cloud, numbered 0, 1, ... by their first point:
 /// the points joined by `same_sheet` edges (`slopes` from `edge_slopes()`,
 /// at most `max_slope`) within one cell of side `cell` (0: anywhere) whose
@@ -138,8 +170,9 @@ bool same_sheet(const Vector& mi, const Vector& mj, float slope, double max_slop
 /// (`moved`, per point; empty: no start); then patches without a sample join
 /// a neighbouring patch through an edge whose oriented normals agree.
 /// Returns the patch of every point (zero normals get a patch of their own).
-/// The tests of the edges run in parallel, the unions in the order of the
-/// edges: the patches are the same for any number of threads.
+/// The tests of the edges run in parallel, the unions mostly so
+/// (`unite_joined_edges()`): the patches are the same for any number of
+/// threads.
 template <typename Kernel, typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
 std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph,
                                          const std::vector<typename Kernel::Point_3>& points,
@@ -172,11 +205,7 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph,
     joins[e] = cells[i] == cells[j] && same_move(i, j) && same_sheet(oriented(i), oriented(j), slopes[e], max_slope);
   });
   Signed_union_find uf(n);
-  typename boost::graph_traits<Neighbor_graph>::edge_iterator it, end;
-  std::size_t e = 0;
-  for (boost::tie(it, end) = edges(graph); it != end; ++it, ++e)
-    if (joins[e])
-      uf.unite(Index(source(*it, graph)), Index(target(*it, graph)));
+  unite_joined_edges<ConcurrencyTag>(graph, joins, uf);
   // Patches without a sample join a sampled neighbour (a few sweeps reach
   // patches two or three steps away), through the edges between two patches
   // whose oriented normals agree (no other edge can ever join two).
@@ -191,7 +220,8 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph,
     joins[e] = root[i] != root[j] && oriented(i) * oriented(j) > 0.0;
   });
   std::vector<std::pair<Index, Index>> between;
-  e = 0;
+  typename boost::graph_traits<Neighbor_graph>::edge_iterator it, end;
+  std::size_t e = 0;
   for (boost::tie(it, end) = edges(graph); it != end; ++it, ++e)
     if (joins[e])
       between.emplace_back(Index(source(*it, graph)), Index(target(*it, graph)));
