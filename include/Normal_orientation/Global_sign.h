@@ -271,12 +271,12 @@ public:
     m_areas = areas;
     m_field.template build<ConcurrencyTag>(points, normals, areas);
     m_energy = internal::winding_energy<ConcurrencyTag>(m_field, m_points, m_areas, m_w);
-    m_w_evaluated = true;
   }
 
   /// the number of samples
   std::size_t size() const { return m_points.size(); }
-  /// w at the samples, with the signs chosen so far
+  /// w at the samples, with the signs chosen so far (evaluated by the
+  /// treecode, then moved by the changes of the patches negated since)
   const std::vector<double>& values() const { return m_w; }
   /// E = sum_j a_j (w_j - 1/2)^2 with the signs chosen so far
   double energy() const { return m_energy; }
@@ -300,7 +300,6 @@ private:
   std::vector<Point_3> m_points;
   std::vector<double> m_areas, m_w;
   double m_energy = 0.0;
-  bool m_w_evaluated = false; ///< m_w is the treecode's, not predicted by the rounds
 };
 
 template <typename Kernel>
@@ -357,15 +356,15 @@ bool Winding_patch_signs<Kernel>::round(const std::vector<std::vector<std::uint3
   }
   if (batch.empty())
     return false;
-  // Negate the batch; w moves by -2 sum c_P, as predicted (the next level
-  // evaluates it anew).
+  // Negate the batch; w moves by -2 sum c_P, as predicted.  The next rounds
+  // and levels start from the prediction, which is the treecode's value up
+  // to the error of the candidates' own fields.
   internal::negate_patches(m_field, batch, members, flip);
   m_energy = 0.0;
   for (std::size_t j = 0; j < n; ++j) {
     m_w[j] = residual[j] + 0.5;
     m_energy += m_areas[j] * residual[j] * residual[j];
   }
-  m_w_evaluated = false;
   return true;
 }
 
@@ -405,7 +404,6 @@ void Winding_patch_signs<Kernel>::keep_closed(const std::vector<std::uint32_t>& 
   if (!undo.empty()) { // open components keep their input signs
     internal::negate_patches(m_field, undo, members, flip);
     m_energy = internal::winding_energy<CGAL::Parallel_if_available_tag>(m_field, m_points, m_areas, m_w);
-    m_w_evaluated = true;
   }
   for (std::size_t P = 0; P < np; ++P)
     report.patches_flipped += flip[P] ? 1 : 0;
@@ -431,10 +429,6 @@ Global_sign_summary Winding_patch_signs<Kernel>::decide(const std::vector<std::u
   report.number_of_patches = np;
   flip.assign(np, 0);
   const std::vector<std::vector<std::uint32_t>> members = internal::patch_members(patch, np);
-  if (!m_w_evaluated) { // the rounds of the last call predicted w: evaluate it anew
-    m_energy = internal::winding_energy<ConcurrencyTag>(m_field, m_points, m_areas, m_w);
-    m_w_evaluated = true;
-  }
   report.energy_before = m_energy;
   while (report.rounds < options.maximum_rounds && round<ConcurrencyTag>(members, fixed, flip, options))
     ++report.rounds;
