@@ -716,6 +716,16 @@ void split_cloud(const std::vector<Point_with_normal>& cloud, std::vector<Point>
   }
 }
 
+/// An unoriented torus of 20,000 points (random signs, from `rng`) in
+/// `points` and `normals`, and its 12-neighbour graph.
+NO::Neighbor_graph_report torus_graph(std::mt19937_64& rng, std::vector<Point>& points, std::vector<Vector>& normals,
+                                      NO::Neighbor_graph& graph)
+{
+  split_cloud(NO::test::unoriented(torus(20000, 1.0, 0.3, rng), rng), points, normals);
+  return NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(points, normals, 12, 0.0, NO::Hoppe_criterion(),
+                                                                graph);
+}
+
 /// the median of all the edge slopes `slopes` (of `edge_slopes()`)
 double median_slope(std::vector<float> slopes)
 {
@@ -776,10 +786,8 @@ TEST(Global_sign, PatchesAreTheSameForAnyNumberOfThreads)
   std::mt19937_64 rng(43);
   std::vector<Point> points;
   std::vector<Vector> normals;
-  split_cloud(NO::test::unoriented(torus(20000, 1.0, 0.3, rng), rng), points, normals);
   NO::Neighbor_graph graph;
-  const NO::Neighbor_graph_report report = NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(
-    points, normals, 12, 0.0, NO::Hoppe_criterion(), graph);
+  const NO::Neighbor_graph_report report = torus_graph(rng, points, normals, graph);
   std::vector<NO::Label> labels(points.size());
   std::vector<char> is_sample(points.size(), 0);
   for (std::size_t i = 0; i < points.size(); ++i) {
@@ -824,9 +832,8 @@ TEST(Global_sign, BlockwiseUnionsGiveTheSetsOfUnitingEveryEdgeInOrder)
   std::mt19937_64 rng(47);
   std::vector<Point> points;
   std::vector<Vector> normals;
-  split_cloud(NO::test::unoriented(torus(20000, 1.0, 0.3, rng), rng), points, normals);
   NO::Neighbor_graph graph;
-  NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(points, normals, 12, 0.0, NO::Hoppe_criterion(), graph);
+  torus_graph(rng, points, normals, graph);
   std::vector<unsigned char> joins(num_edges(graph));
   for (unsigned char& j : joins)
     j = rng() % 8 == 0; // one edge in eight: thousands of sets, many spanning blocks
