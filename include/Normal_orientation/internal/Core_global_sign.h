@@ -78,17 +78,25 @@ constexpr double sheet_slope = 0.5;
 /// about 8.6 degrees from both tangent planes.
 constexpr double patch_slope_floor = 0.15;
 
+/// Calls `f(j, e)` for every out-edge (i, j) of `graph`, e its rank in the
+/// order of `edges(graph)` (that of the sources' out-edges).
+template <typename Function>
+void for_each_out_edge(const Neighbor_graph& graph, std::size_t i, const Function& f)
+{
+  typename boost::graph_traits<Neighbor_graph>::out_edge_iterator it, end;
+  for (boost::tie(it, end) = out_edges(std::uint32_t(i), graph); it != end; ++it)
+    f(std::size_t(target(*it, graph)), std::size_t(get(boost::edge_index, graph, *it)));
+}
+
 /// Calls `f(i, j, e)` for every edge (i, j) of `graph`, e its rank in the
-/// order of `edges(graph)` (that of the sources' out-edges), in parallel
-/// over the sources: `f` may write to slot e of a per-edge array.
+/// order of `edges(graph)`, in parallel over the sources: `f` may write to
+/// slot e of a per-edge array.
 template <typename ConcurrencyTag, typename Function>
 void for_each_edge_in_parallel(const Neighbor_graph& graph, const Function& f)
 {
   parallel_chunks<ConcurrencyTag>(std::size_t(num_vertices(graph)), [&](std::size_t b, std::size_t e) {
-    typename boost::graph_traits<Neighbor_graph>::out_edge_iterator it, end;
     for (std::size_t i = b; i < e; ++i)
-      for (boost::tie(it, end) = out_edges(std::uint32_t(i), graph); it != end; ++it)
-        f(i, std::size_t(target(*it, graph)), std::size_t(get(boost::edge_index, graph, *it)));
+      for_each_out_edge(graph, i, [&](std::size_t j, std::size_t edge) { f(i, j, edge); });
   });
 }
 
@@ -145,18 +153,16 @@ void unite_joined_edges(const Neighbor_graph& graph, const std::vector<unsigned 
   const std::size_t n = std::size_t(num_vertices(graph)), blocks = (n + block - 1) / block;
   std::vector<std::vector<std::pair<Index, Index>>> across(blocks);
   parallel_chunks<ConcurrencyTag>(blocks, [&](std::size_t bb, std::size_t be) {
-    typename boost::graph_traits<Neighbor_graph>::out_edge_iterator it, end;
     for (std::size_t b = bb; b < be; ++b)
       for (std::size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
-        for (boost::tie(it, end) = out_edges(Index(i), graph); it != end; ++it) {
-          const Index j = Index(target(*it, graph));
-          if (!joins[std::size_t(get(boost::edge_index, graph, *it))])
-            continue;
+        for_each_out_edge(graph, i, [&](std::size_t j, std::size_t e) {
+          if (!joins[e])
+            return;
           if (j / block == b)
-            uf.unite(Index(i), j);
+            uf.unite(Index(i), Index(j));
           else
-            across[b].emplace_back(Index(i), j);
-        }
+            across[b].emplace_back(Index(i), Index(j));
+        });
   }, 1);
   for (const auto& pairs : across)
     for (const auto& ij : pairs)
