@@ -152,6 +152,15 @@ inline Part annulus(double r_in, double r_out, double height, double nz)
           }};
 }
 
+/// The closed surface of a cylinder of axis z with a coaxial bore, z in [0, height]: the outer
+/// wall of radius r_out (normals away from the axis), the bore of radius r_in < r_out (normals
+/// towards the axis), and the annular ends (normals -z at z = 0, +z at z = height).
+inline std::vector<Part> bored_cylinder_parts(double r_in, double r_out, double height)
+{
+  return {cylinder_wall(r_out, 0.0, height, false), cylinder_wall(r_in, 0.0, height, true),
+          annulus(r_in, r_out, 0.0, -1.0), annulus(r_in, r_out, height, 1.0)};
+}
+
 /// The torus of axis z, centred at the origin, with radii R > r; normals outward. The two
 /// angles are uniform and a proposal is kept with probability (R + r cos b) / (R + r).
 inline Part torus(double R, double r)
@@ -361,10 +370,7 @@ inline std::vector<Sample> thin_plate(std::size_t n, std::mt19937_64& rng)
  */
 inline std::vector<Sample> thin_pipe(std::size_t n, std::mt19937_64& rng)
 {
-  using namespace internal;
-  return sample_parts({cylinder_wall(1.0, 0.0, 1.5, false), cylinder_wall(0.994, 0.0, 1.5, true),
-                       annulus(0.994, 1.0, 0.0, -1.0), annulus(0.994, 1.0, 1.5, 1.0)},
-                      n, rng);
+  return internal::sample_parts(internal::bored_cylinder_parts(0.994, 1.0, 1.5), n, rng);
 }
 
 /**
@@ -388,10 +394,7 @@ inline std::vector<Sample> thin_dome(std::size_t n, std::mt19937_64& rng)
  */
 inline std::vector<Sample> bored_cylinder(std::size_t n, std::mt19937_64& rng)
 {
-  using namespace internal;
-  return sample_parts({cylinder_wall(1.0, 0.0, 1.5, false), cylinder_wall(0.5, 0.0, 1.5, true),
-                       annulus(0.5, 1.0, 0.0, -1.0), annulus(0.5, 1.0, 1.5, 1.0)},
-                      n, rng);
+  return internal::sample_parts(internal::bored_cylinder_parts(0.5, 1.0, 1.5), n, rng);
 }
 
 /**
