@@ -47,8 +47,9 @@ namespace internal {
 /// 0.85-0.93; 200k points with noise 0.5%, 0.65-0.70 (0.84 on the cheese).
 constexpr double coarse_coherence_threshold = 0.9;
 /// The coarse signs are taken when the closedness of the coarse orientation
-/// exceeds that of the fine one by this much.
-constexpr double coarse_closedness_margin = 0.05;
+/// exceeds that of the fine one by this much (the manual, "Noise Wider than
+/// the Spacing", gives the closedness of both where either wins).
+constexpr double coarse_closedness_margin = 0.02;
 /// The fewest points a coarse cloud may have.
 constexpr std::size_t coarse_minimum_points = 1000;
 /// The most cells the accumulator holds (about 40 MB); beyond, the cells
