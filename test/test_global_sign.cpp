@@ -10,6 +10,7 @@
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/orient_normals.h>
+#include <Normal_orientation/streaming/Patch_units.h>
 
 #include <CGAL/pca_estimate_normals.h>
 
@@ -775,6 +776,105 @@ TEST(Global_sign, PatchesSeparateLayersCloserThanTheSpacing)
   EXPECT_EQ(parted, 2u);
   for (std::size_t i = 0; i < points.size(); ++i)
     EXPECT_EQ(apart[i] == apart[0], !moved[i]) << i;
+}
+
+TEST(Patch_units, UnitsFollowTheSheetsAcrossSegments)
+{
+  // Two layers 1.5 spacings apart, pushed in the order of x as a sweep would
+  // push them: every edge between the layers is steeper than sheet_slope, so
+  // the units never join the layers, even where one final segment holds both
+  // (segments here are stripes of x, across the layers), and the patches of
+  // the current signs are the layers: one each whatever the segments, two
+  // per layer where half of one layer is negated.
+  std::vector<Point> points;
+  std::vector<Vector> normals;
+  two_layers(2500, 1.0, 1.5, points, normals);
+  NO::Neighbor_graph graph;
+  NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(points, normals, 12, 0.0, NO::Hoppe_criterion(), graph);
+  std::vector<std::size_t> order(points.size());
+  for (std::size_t i = 0; i < order.size(); ++i)
+    order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return points[a].x() < points[b].x(); });
+  std::vector<std::size_t> rank(points.size());
+  for (std::size_t t = 0; t < order.size(); ++t)
+    rank[order[t]] = t;
+  std::vector<std::vector<NO::streaming::Earlier_edge>> earlier(points.size());
+  std::uint64_t span = 1;
+  std::size_t across = 0;
+  for (auto e : boost::make_iterator_range(edges(graph))) {
+    std::size_t a = rank[source(e, graph)], b = rank[target(e, graph)];
+    if (a < b)
+      std::swap(a, b);
+    earlier[a].push_back({std::uint32_t(a - b), 1.0f});
+    span = std::max<std::uint64_t>(span, a - b);
+    across += points[source(e, graph)].z() != points[target(e, graph)].z() ? 1 : 0;
+  }
+  ASSERT_GT(across, 0u);
+  NO::streaming::internal::Patch_units units(span, 4.0); // (cells hold both layers)
+  std::vector<std::uint32_t> unit(points.size());
+  const Vector up(0, 0, 1);
+  for (std::size_t t = 0; t < order.size(); ++t) {
+    const Point& p = points[order[t]];
+    const std::uint32_t segment = std::uint32_t(p.x() / 7.0); // stripes across both layers
+    unit[order[t]] = units.push(p, up, segment, 0, earlier[t].data(), earlier[t].size());
+  }
+  const std::size_t nu = units.number_of_units();
+  ASSERT_GT(nu, 2u);
+  auto layer_of = [&](std::size_t i) { return points[i].z() == 0.0 ? 0 : 1; };
+  std::vector<int> unit_layer(nu, -1);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    EXPECT_TRUE(unit_layer[unit[i]] == -1 || unit_layer[unit[i]] == layer_of(i)) << i;
+    unit_layer[unit[i]] = layer_of(i);
+  }
+  const double slope = units.patch_slope();
+  EXPECT_GE(slope, NO::internal::patch_slope_floor);
+  EXPECT_LE(slope, NO::internal::sheet_slope);
+  for (int level = 0; level < 3; ++level) {
+    const std::vector<std::uint32_t> sheet = units.patches(std::vector<char>(nu, 0), NO::internal::sheet_slope, level);
+    if (level == 0) {
+      std::uint32_t id[2] = {std::uint32_t(sheet.size()), std::uint32_t(sheet.size())};
+      for (std::size_t u = 0; u < nu; ++u) {
+        std::uint32_t& layer_id = id[unit_layer[u]];
+        if (layer_id == std::uint32_t(sheet.size()))
+          layer_id = sheet[u];
+        EXPECT_EQ(sheet[u], layer_id) << u;
+      }
+      EXPECT_NE(id[0], id[1]);
+    } else {
+      for (std::size_t u = 0; u < nu; ++u) // cells part the layers further, never join them
+        for (std::size_t v = 0; v < nu; ++v)
+          if (unit_layer[u] != unit_layer[v]) {
+            EXPECT_NE(sheet[u], sheet[v]);
+          }
+    }
+  }
+  // Negate the units of the lower layer with x < 24: its two halves now
+  // disagree along x = 24, so they are two patches; the upper layer stays one.
+  std::vector<char> negated(nu, 0);
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (layer_of(i) == 0 && points[i].x() < 24.0)
+      negated[unit[i]] = 1;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (layer_of(i) == 0 && points[i].x() >= 24.0) {
+      ASSERT_FALSE(negated[unit[i]]) << "a unit straddles x = 24"; // (a cell border)
+    }
+  const std::vector<std::uint32_t> patch = units.patches(negated, NO::internal::sheet_slope, 0);
+  std::vector<std::vector<std::uint32_t>> of_part(3);
+  for (std::size_t u = 0; u < nu; ++u)
+    of_part[unit_layer[u] == 1 ? 2 : negated[u]].push_back(patch[u]);
+  for (const auto& ids : of_part) {
+    ASSERT_FALSE(ids.empty());
+    EXPECT_TRUE(std::all_of(ids.begin(), ids.end(), [&](std::uint32_t id) { return id == ids[0]; }));
+  }
+  EXPECT_NE(of_part[0][0], of_part[1][0]);
+  EXPECT_NE(of_part[0][0], of_part[2][0]);
+  EXPECT_NE(of_part[1][0], of_part[2][0]);
+  // An edge reaching farther back than the span is an error.
+  NO::streaming::internal::Patch_units short_units(1, 1.0);
+  const NO::streaming::Earlier_edge far{2, 1.0f};
+  short_units.push(points[0], up, 0, 0, nullptr, 0);
+  short_units.push(points[1], up, 0, 0, nullptr, 0);
+  EXPECT_THROW(short_units.push(points[2], up, 0, 0, &far, 1), std::runtime_error);
 }
 
 TEST(Global_sign, PatchesAreTheSameForAnyNumberOfThreads)

@@ -299,7 +299,9 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
       Normal_orientation::internal::Global_settings g = global;
       g.dense_samples = dense;
       result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component,
-                                                   swept.segment_has_unary, radius, n, g, stage(Stage::GLOBAL));
+                                                   swept.segment_has_unary, radius, n, g, stage(Stage::GLOBAL),
+                                                   Unit_inputs{edges.get(), result.edge_span,
+                                                               settings.temporary_directory});
       result.seconds.global += seconds_since(t);
     }
   };

@@ -4,16 +4,17 @@
 #define NORMAL_ORIENTATION_STREAMING_GLOBAL_STAGE_H
 
 /// \file Global_stage.h
-/// The global sign stage of the streaming driver: the winding number of a
-/// bounded subsample of the labelled records decides the signs of patches
-/// (the final segments, cut by cells, as the in-core patches are), and every
-/// point follows the samples near it.
+/// The global sign stage of the streaming driver: exterior visibility and
+/// the winding number of a bounded subsample of the labelled records decide
+/// the signs of patches (unions of `Patch_units`, as the in-core patches are
+/// unions of points), and every point follows its unit.
 
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Winding_number_field.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/streaming/Labelled_records.h>
+#include <Normal_orientation/streaming/Patch_units.h>
 #include <Normal_orientation/streaming/Segmenting_sweep.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -26,6 +27,7 @@
 #include <cstdint>
 #include <memory>
 #include <numeric>
+#include <string>
 #include <unordered_map>
 #include <vector>
 
@@ -43,33 +45,64 @@ struct Global_samples
   std::vector<typename Kernel::Vector_3> normals; ///< unit, oriented
   std::vector<std::uint32_t> segment;             ///< final segment
   std::vector<std::uint32_t> component;           ///< component
+  std::vector<std::uint32_t> unit;                ///< patch unit (with `Patch_units`)
 };
 
-/// One pass: the samples.
+/// What the global stage needs to build its patches from units
+/// (`Patch_units`): the sweep's edge file and span, and the directory of the
+/// unit file.  Without an edge file (no refinement), the patches are the
+/// final segments, cut by cells.
+struct Unit_inputs
+{
+  Record_file<Earlier_edge>* edges = nullptr;
+  std::uint64_t span = 0;
+  std::string temporary_directory;
+};
+
+/// One pass: the samples.  With `units`, the same pass pushes every point
+/// into `units`, with its earlier edges from `edges`, and appends its unit
+/// to `unit_file`.
 template <typename Kernel>
 Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std::vector<std::uint32_t>& component,
-                                              const std::vector<char>& flip_component, std::uint64_t stride)
+                                              const std::vector<char>& flip_component, std::uint64_t stride,
+                                              Patch_units* units = nullptr, Record_file<Earlier_edge>* edges = nullptr,
+                                              Record_file<std::uint32_t>* unit_file = nullptr)
 {
   Global_samples<Kernel> out;
   points.rewind();
+  std::unique_ptr<Edge_reader> edge_reader;
+  if (units)
+    edge_reader = std::make_unique<Edge_reader>(*edges, false);
   std::uint64_t at = 0;
   while (points.read() > 0) {
     const std::vector<Swept_record>& buffer = points.points();
     for (std::size_t q = 0; q < buffer.size(); ++q, ++at) {
-      if (at % stride != 0)
-        continue;
       const Swept_record& s = buffer[q];
-      const std::array<double, 3> u = unit_normal(s.record);
-      if (u[0] == 0.0 && u[1] == 0.0 && u[2] == 0.0)
-        continue;
       const std::uint32_t c = component[s.segment];
       const double sign = double(points.labels()[q]) * (flip_component[c] ? -1.0 : 1.0);
+      const std::array<double, 3> u = unit_normal(s.record);
+      std::uint32_t unit = 0;
+      if (units) {
+        const Earlier_edge* point_edges = nullptr;
+        std::size_t count = 0;
+        edge_reader->next(point_edges, count);
+        unit = units->push(Patch_units::Kernel::Point_3(s.record.position[0], s.record.position[1],
+                                                        s.record.position[2]),
+                           Patch_units::Kernel::Vector_3(sign * u[0], sign * u[1], sign * u[2]),
+                           points.segments()[q], c, point_edges, count);
+        unit_file->append(unit);
+      }
+      if (at % stride != 0 || (u[0] == 0.0 && u[1] == 0.0 && u[2] == 0.0))
+        continue;
       out.points.emplace_back(s.record.position[0], s.record.position[1], s.record.position[2]);
       out.normals.emplace_back(sign * u[0], sign * u[1], sign * u[2]);
       out.segment.push_back(points.segments()[q]);
       out.component.push_back(c);
+      out.unit.push_back(unit);
     }
   }
+  if (unit_file)
+    unit_file->flush();
   return out;
 }
 
@@ -152,28 +185,199 @@ std::vector<std::uint32_t> segment_patches(const std::vector<Point>& points, con
   return patch;
 }
 
+/// The side of the cells of `Patch_units`: 0.7 neighbour radii, times
+/// sqrt(stride / 4) where the samples are sparser than one in four points,
+/// so that the units stay about as many as the samples.
+inline double unit_cell(double radius, std::uint64_t stride)
+{
+  return 0.7 * radius * std::max(1.0, std::sqrt(double(stride) / 4.0));
+}
+
+/// Installs `Global_point_flips` in `labels`: every point follows the
+/// samples near it (`sample_flip`, per sample).
+template <typename Kernel>
+void install_sample_flips(Global_samples<Kernel>& samples, const std::vector<double>& areas,
+                          std::vector<char>& sample_flip, const std::vector<std::uint32_t>& component,
+                          const std::vector<char>& flip_component, Point_labels& labels)
+{
+  const std::size_t ns = samples.points.size();
+  auto flips = std::make_shared<Global_point_flips>();
+  const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
+  flips->grid = std::make_shared<const Sample_grid>(samples.points, 2.0 * std::sqrt(area / double(ns)));
+  std::unordered_map<std::uint32_t, std::int64_t> votes;
+  for (std::size_t j = 0; j < ns; ++j) {
+    const auto& v = samples.normals[j];
+    flips->normal.push_back({{v.x(), v.y(), v.z()}});
+    votes[samples.segment[j]] += sample_flip[j] ? 1 : -1;
+  }
+  for (const auto& v : votes)
+    flips->segment_flip.emplace(v.first, char(v.second > 0));
+  flips->component = std::move(samples.component);
+  flips->flip = std::move(sample_flip);
+  flips->segment_component = &component;
+  flips->flip_component = flip_component;
+  labels.point_flip = [flips](const Swept_record& s, std::uint32_t segment, Label label) {
+    return (*flips)(s, segment, label);
+  };
+}
+
+/// The visibility decisions of the streamed global stage, per sample and,
+/// with units, per unit: whether the point is negated after the component's
+/// decision (its sheet's, then its final segment's).
+struct Stream_seen_sides
+{
+  Normal_orientation::internal::Seen_side_flips seen; ///< components and sheets
+  std::vector<std::uint32_t> sheet;                  ///< per sample
+  std::size_t number_of_sheets = 0;
+  std::vector<char> sample;                          ///< per sample
+  std::vector<char> unit;                            ///< per unit
+  std::vector<std::uint32_t> unit_sheet;             ///< per unit
+};
+
+/// Exterior visibility over the samples: components, then sheets (with
+/// `units`, the unit patches of slope at most `sheet_slope`, as in core;
+/// else the final segments), then, with units, the final segments that
+/// still face away from where they were seen.
+template <typename ConcurrencyTag, typename Kernel>
+Stream_seen_sides stream_seen_sides(const Global_samples<Kernel>& samples, const std::vector<double>& areas,
+                                    const std::vector<std::uint32_t>& segment_patch, std::size_t number_of_segments,
+                                    std::size_t number_of_components, const std::vector<char>& component_fixed,
+                                    const Patch_units* units,
+                                    const Normal_orientation::internal::Global_settings& settings)
+{
+  Stream_seen_sides out;
+  const std::size_t ns = samples.points.size();
+  if (units) {
+    out.unit_sheet = units->patches(std::vector<char>(units->number_of_units(), 0),
+                                    Normal_orientation::internal::sheet_slope, 0);
+    for (std::size_t j = 0; j < ns; ++j) {
+      out.sheet.push_back(out.unit_sheet[samples.unit[j]]);
+      out.number_of_sheets = std::max<std::size_t>(out.number_of_sheets, std::size_t(out.sheet.back()) + 1);
+    }
+  } else {
+    out.sheet = segment_patch;
+    out.number_of_sheets = number_of_segments;
+  }
+  out.seen = Normal_orientation::internal::seen_side_flips<ConcurrencyTag>(
+    samples.points, samples.normals, areas, samples.component, out.sheet, number_of_components,
+    out.number_of_sheets, component_fixed, settings);
+  std::vector<char> segment_flip(number_of_segments, 0);
+  if (units && settings.orientation == Normal_orientation::Global_orientation::VISIBILITY_AND_WINDING) {
+    std::vector<double> vote = out.seen.vote;
+    std::vector<char> free_segment(number_of_segments, 0);
+    for (std::size_t j = 0; j < ns; ++j) {
+      free_segment[segment_patch[j]] = !component_fixed[samples.component[j]];
+      if (out.seen.component[samples.component[j]] != out.seen.patch[out.sheet[j]])
+        vote[j] = -vote[j];
+    }
+    segment_flip = visibility_flips(vote, areas, segment_patch, free_segment);
+    for (char f : segment_flip)
+      out.seen.patches_flipped += f ? 1 : 0;
+  }
+  out.sample.resize(ns);
+  for (std::size_t j = 0; j < ns; ++j)
+    out.sample[j] = char(out.seen.patch[out.sheet[j]] ^ segment_flip[segment_patch[j]]);
+  if (units) {
+    std::unordered_map<std::uint32_t, char> by_segment; // final segment -> its flip, where it has samples
+    for (std::size_t j = 0; j < ns; ++j)
+      by_segment[samples.segment[j]] = segment_flip[segment_patch[j]];
+    out.unit.resize(units->number_of_units());
+    for (std::size_t u = 0; u < out.unit.size(); ++u) {
+      const auto it = by_segment.find(units->unit_segment()[u]);
+      out.unit[u] = char(out.seen.patch[out.unit_sheet[u]] ^ (it != by_segment.end() ? it->second : 0));
+    }
+  }
+  return out;
+}
+
+/// The winding number's three levels over the samples, from the negations
+/// `sample_flip` (per sample, after visibility), and with units
+/// `unit_flip` (per unit), which it updates: with units, the unit patches of
+/// the current signs (`Patch_units::patches()`, anywhere, then within coarse
+/// cells, then within cells); else the final segments, then the segments
+/// cut by cells of `patch_cell_radii` radii.
+template <typename ConcurrencyTag, typename Kernel>
+void stream_winding_levels(const Global_samples<Kernel>& samples, Winding_patch_signs<Kernel>& search,
+                           const Patch_units* units, const std::vector<std::uint32_t>& segment_patch,
+                           std::size_t number_of_segments, double radius, const std::vector<char>& has_unary,
+                           std::vector<char>& sample_flip, std::vector<char>& unit_flip, Global_sign_summary& report)
+{
+  const std::size_t ns = samples.points.size();
+  const double slope = units ? units->patch_slope() : 0.0;
+  int level = 0;
+  for (double cell_radii : Normal_orientation::internal::patch_cell_radii) {
+    std::vector<std::uint32_t> first, of_unit;
+    std::vector<std::uint32_t> patch;
+    if (units) {
+      of_unit = units->patches(unit_flip, slope, level);
+      std::vector<std::uint32_t> ids(ns);
+      for (std::size_t j = 0; j < ns; ++j)
+        ids[j] = of_unit[samples.unit[j]];
+      patch = segment_patches(samples.points, ids, 0.0, first);
+    } else if (cell_radii == 0.0) {
+      patch = segment_patch;
+      first.resize(number_of_segments);
+      for (std::size_t j = ns; j-- > 0;)
+        first[segment_patch[j]] = std::uint32_t(j);
+    } else {
+      patch = segment_patches(samples.points, samples.segment, cell_radii * radius, first);
+    }
+    std::vector<std::uint32_t> patch_component(first.size());
+    std::vector<char> fixed(first.size(), 0);
+    for (std::size_t P = 0; P < first.size(); ++P)
+      patch_component[P] = samples.component[first[P]];
+    for (std::size_t j = 0; j < ns && !has_unary.empty(); ++j)
+      fixed[patch[j]] |= has_unary[samples.segment[j]];
+    std::vector<char> flip;
+    const Global_sign_summary decided = search.template decide<ConcurrencyTag>(
+      patch, patch_component, fixed, flip, Normal_orientation::internal::winding_level_options(units && level == 0));
+    for (std::size_t j = 0; j < ns; ++j)
+      sample_flip[j] ^= flip[patch[j]];
+    if (units) {
+      const std::uint32_t unset = ~std::uint32_t(0);
+      std::vector<std::uint32_t> sampled(units->number_of_units(), unset); // unit patch -> its patch, if sampled
+      for (std::size_t j = 0; j < ns; ++j)
+        sampled[of_unit[samples.unit[j]]] = patch[j];
+      for (std::size_t u = 0; u < unit_flip.size(); ++u)
+        if (sampled[of_unit[u]] != unset && flip[sampled[of_unit[u]]])
+          unit_flip[u] ^= 1;
+    }
+    Normal_orientation::internal::add_level(report, decided);
+    ++level;
+  }
+}
+
 /// The global stage on the labelled records, as in core on a subsample:
-/// exterior visibility (`seen_side_flips()`) over the components and the
-/// final segments, then the winding number (`Winding_patch_signs`) over
-/// three levels of patches (the final segments, then the segments cut by
-/// cells of 4 and 1.5 radii).  Whole components negate in
-/// `flip_component` (the sign stage's decision, per component); the points
-/// follow the samples for the rest (`Global_point_flips`, installed in
-/// `labels`).  `component` and `segment_has_unary` are per sweep segment.
-/// Memory: the subsample, and O(segments).
+/// exterior visibility (`stream_seen_sides()`), then the winding number
+/// (`Winding_patch_signs`) over three levels of patches
+/// (`stream_winding_levels()`), then the seen-side vetoes and the top
+/// surface.  With `unit_inputs.edges`, the patches are unions of units
+/// (`Patch_units`), built in the pass that takes the samples, and every
+/// point follows its unit (a unit file installed in `labels`); else the
+/// points follow the samples (`Global_point_flips`).  Whole components
+/// negate in `flip_component` (the sign stage's decision, per component).
+/// `component` and `segment_has_unary` are per sweep segment.  Memory: the
+/// subsample, the units and O(segments).
 template <typename ConcurrencyTag>
 Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
                                  const std::vector<std::uint32_t>& component, std::vector<char>& flip_component,
                                  const std::vector<char>& segment_has_unary, double radius, std::uint64_t n,
                                  const Normal_orientation::internal::Global_settings& settings,
-                                 const Progress_reporter& progress)
+                                 const Progress_reporter& progress, const Unit_inputs& unit_inputs = Unit_inputs())
 {
   typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
   const auto t0 = std::chrono::steady_clock::now();
   progress.report(0, 4);
   const std::uint64_t m = std::max<std::uint64_t>(1, global_samples(n, settings.dense_samples));
   const std::uint64_t stride = std::max<std::uint64_t>(1, (n + m - 1) / m);
-  Global_samples<Kernel> samples = collect_global_samples<Kernel>(points, component, flip_component, stride);
+  std::unique_ptr<Patch_units> units;
+  std::unique_ptr<Record_file<std::uint32_t>> unit_file;
+  if (unit_inputs.edges) {
+    units = std::make_unique<Patch_units>(unit_inputs.span, unit_cell(radius, stride));
+    unit_file = std::make_unique<Record_file<std::uint32_t>>(unit_inputs.temporary_directory, 1 << 16);
+  }
+  Global_samples<Kernel> samples = collect_global_samples<Kernel>(points, component, flip_component, stride,
+                                                                  units.get(), unit_inputs.edges, unit_file.get());
   progress.report(1, 4);
   Global_sign_summary report;
   const std::size_t ns = samples.points.size();
@@ -184,93 +388,66 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   std::vector<double> areas = estimate_point_areas<ConcurrencyTag>(samples.points, samples.normals);
   Normal_orientation::internal::cap_areas(areas);
   // Exterior visibility first: whole components negate in flip_component,
-  // segments through the samples.
+  // sheets and segments through the samples and the units.
   const std::size_t nc = flip_component.size();
   std::vector<char> component_fixed(nc, 0);
-  if (!labels.label_file)
-    for (std::size_t j = 0; j < ns; ++j)
-      component_fixed[samples.component[j]] |= segment_has_unary[samples.segment[j]];
-  std::vector<std::uint32_t> sheet_first;
-  const std::vector<std::uint32_t> sheet = segment_patches(samples.points, samples.segment, 0.0, sheet_first);
-  const Normal_orientation::internal::Seen_side_flips seen = Normal_orientation::internal::seen_side_flips<ConcurrencyTag>(
-    samples.points, samples.normals, areas, samples.component, sheet, nc, sheet_first.size(), component_fixed,
-    settings);
-  std::vector<char> sample_flip(ns, 0);
+  const std::vector<char> no_unary;
+  const std::vector<char>& has_unary = labels.label_file ? no_unary : segment_has_unary; // (with unary terms there is no refinement: the final segments are the sweep's)
+  for (std::size_t j = 0; j < ns && !has_unary.empty(); ++j)
+    component_fixed[samples.component[j]] |= has_unary[samples.segment[j]];
+  std::vector<std::uint32_t> segment_first;
+  const std::vector<std::uint32_t> segment_patch = segment_patches(samples.points, samples.segment, 0.0, segment_first);
+  const Stream_seen_sides seen = stream_seen_sides<ConcurrencyTag>(
+    samples, areas, segment_patch, segment_first.size(), nc, component_fixed, units.get(), settings);
+  std::vector<char> sample_flip(seen.sample), unit_flip(seen.unit);
   std::vector<Kernel::Vector_3> oriented(samples.normals);
-  for (std::size_t j = 0; j < ns; ++j) {
-    sample_flip[j] = seen.patch[sheet[j]];
-    if (seen.component[samples.component[j]] != sample_flip[j])
+  for (std::size_t j = 0; j < ns; ++j)
+    if (seen.seen.component[samples.component[j]] != sample_flip[j])
       oriented[j] = -oriented[j];
-  }
   Winding_patch_signs<Kernel> search;
   search.template build<ConcurrencyTag>(samples.points, oriented, areas);
-  for (double cell_radii : Normal_orientation::internal::patch_cell_radii) {
-    std::vector<std::uint32_t> cut_first; // (the first level is the sheets: segments do not change)
-    const std::vector<std::uint32_t> patch =
-      cell_radii == 0.0 ? sheet : segment_patches(samples.points, samples.segment, cell_radii * radius, cut_first);
-    const std::vector<std::uint32_t>& first = cell_radii == 0.0 ? sheet_first : cut_first;
-    std::vector<std::uint32_t> patch_component(first.size());
-    std::vector<char> fixed(first.size(), 0);
-    for (std::size_t P = 0; P < first.size(); ++P)
-      patch_component[P] = samples.component[first[P]];
-    if (!labels.label_file) // (with unary terms there is no refinement: the final segments are the sweep's)
-      for (std::size_t j = 0; j < ns; ++j)
-        fixed[patch[j]] |= segment_has_unary[samples.segment[j]];
-    std::vector<char> flip;
-    const Global_sign_summary level = search.template decide<ConcurrencyTag>(
-      patch, patch_component, fixed, flip, Normal_orientation::internal::winding_level_options(false));
-    for (std::size_t j = 0; j < ns; ++j)
-      sample_flip[j] ^= flip[patch[j]];
-    Normal_orientation::internal::add_level(report, level);
-  }
+  stream_winding_levels<ConcurrencyTag>(samples, search, units.get(), segment_patch, segment_first.size(), radius,
+                                        has_unary, sample_flip, unit_flip, report);
   // The winding number's flips against both the solver and visibility, in
-  // the segments they turn away from where they were seen, are undone.
+  // the sheets they turn away from where they were seen, are undone.
   std::vector<char> by_visibility(ns), by_winding(ns);
   for (std::size_t j = 0; j < ns; ++j) {
-    by_visibility[j] = seen.component[samples.component[j]] != seen.patch[sheet[j]];
-    by_winding[j] = sample_flip[j] != seen.patch[sheet[j]];
+    by_visibility[j] = seen.seen.component[samples.component[j]] != seen.sample[j];
+    by_winding[j] = sample_flip[j] != seen.sample[j];
   }
   const std::vector<char> veto = Normal_orientation::internal::seen_side_vetoes(
-    seen.vote, areas, sheet, by_visibility, by_winding, sheet_first.size());
+    seen.seen.vote, areas, seen.sheet, by_visibility, by_winding, seen.number_of_sheets);
   for (std::size_t j = 0; j < ns; ++j)
-    if (veto[sheet[j]] && Normal_orientation::internal::negated_against_both(by_visibility[j], by_winding[j]))
-      sample_flip[j] = seen.patch[sheet[j]];
+    if (veto[seen.sheet[j]] && Normal_orientation::internal::negated_against_both(by_visibility[j], by_winding[j]))
+      sample_flip[j] = seen.sample[j];
+  for (std::size_t u = 0; u < unit_flip.size(); ++u) {
+    const char visible = seen.seen.component[units->unit_component()[u]] != seen.unit[u];
+    if (veto[seen.unit_sheet[u]] &&
+        Normal_orientation::internal::negated_against_both(visible, char(unit_flip[u] != seen.unit[u])))
+      unit_flip[u] = seen.unit[u];
+  }
   for (char v : veto)
     report.seen_vetoes += v ? 1 : 0;
   // Components whose top surface faces down are negated.
   for (std::size_t j = 0; j < ns; ++j)
-    oriented[j] = seen.component[samples.component[j]] != sample_flip[j] ? -samples.normals[j] : samples.normals[j];
+    oriented[j] = seen.seen.component[samples.component[j]] != sample_flip[j] ? -samples.normals[j] : samples.normals[j];
   const std::vector<char> top = Normal_orientation::internal::top_side_flips<ConcurrencyTag>(
     samples.points, oriented, areas, samples.component, nc, component_fixed, settings);
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
   progress.report(3, 4);
   report.points_flipped = 0; // (counted in core only)
-  if (std::find(sample_flip.begin(), sample_flip.end(), 1) != sample_flip.end()) {
-    auto flips = std::make_shared<Global_point_flips>();
-    const double area = std::accumulate(areas.begin(), areas.end(), 0.0);
-    flips->grid = std::make_shared<const Sample_grid>(samples.points, 2.0 * std::sqrt(area / double(ns)));
-    std::unordered_map<std::uint32_t, std::int64_t> votes;
-    for (std::size_t j = 0; j < ns; ++j) {
-      const auto& v = samples.normals[j];
-      flips->normal.push_back({{v.x(), v.y(), v.z()}});
-      votes[samples.segment[j]] += sample_flip[j] ? 1 : -1;
-    }
-    for (const auto& v : votes)
-      flips->segment_flip.emplace(v.first, char(v.second > 0));
-    flips->component = std::move(samples.component);
-    flips->flip = std::move(sample_flip);
-    flips->segment_component = &component;
-    flips->flip_component = flip_component;
-    labels.point_flip = [flips](const Swept_record& s, std::uint32_t segment, Label label) {
-      return (*flips)(s, segment, label);
-    };
+  if (units) {
+    labels.unit_file = std::move(unit_file);
+    labels.unit_flip = std::move(unit_flip);
+  } else if (std::find(sample_flip.begin(), sample_flip.end(), 1) != sample_flip.end()) {
+    install_sample_flips(samples, areas, sample_flip, component, flip_component, labels);
   }
   for (std::size_t c = 0; c < nc; ++c)
-    flip_component[c] ^= char(seen.component[c] != top[c]);
+    flip_component[c] ^= char(seen.seen.component[c] != top[c]);
   report.visibility = settings.orientation == Normal_orientation::Global_orientation::VISIBILITY_AND_WINDING;
-  report.seen_components_flipped = seen.components_flipped;
-  report.seen_patches_flipped = seen.patches_flipped;
+  report.seen_components_flipped = seen.seen.components_flipped;
+  report.seen_patches_flipped = seen.seen.patches_flipped;
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress.report(4, 4);
   return report;

@@ -7,7 +7,8 @@
 /// The swept points with their labels, as the stages after the solve read
 /// them: the record file, and either the segment labels of the solve
 /// (label = preliminary flip times the segment's label) or the label file
-/// of the last refinement round (label times the label of its segment).
+/// of the last refinement round (label times the label of its segment),
+/// and the global stage's negations.
 
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/streaming/Record_file.h>
@@ -34,7 +35,11 @@ struct Point_labels
   /// when set, the points for which it returns true (given the point, its
   /// final segment and its label) are negated too: the global stage's decision
   std::function<bool(const Swept_record&, std::uint32_t, Label)> point_flip;
-
+  /// when set, the patch unit of every point (`Patch_units`), and per unit
+  /// whether its points are negated (the global stage's decision, before
+  /// `point_flip`)
+  std::unique_ptr<Record_file<std::uint32_t>> unit_file;
+  std::vector<char> unit_flip; ///< per unit
 };
 
 /// Reads the record file and the labels, in the sweep order, block by block.
@@ -50,6 +55,8 @@ public:
     m_records.rewind();
     if (m_labels.label_file)
       m_labels.label_file->rewind();
+    if (m_labels.unit_file)
+      m_labels.unit_file->rewind();
   }
 
   /// reads the next points into `points()` and their labels (before the
@@ -74,6 +81,14 @@ public:
         m_segments[q] = m_buffer[q].segment;
         m_point_labels[q] = Label(m_buffer[q].flip * m_labels.segment_labels[m_buffer[q].segment]);
       }
+    }
+    if (m_labels.unit_file) {
+      m_words.clear();
+      if (got > 0 && m_labels.unit_file->read(m_words, got) != got)
+        throw std::runtime_error("streaming_orient_normals: the unit file is shorter than the record file");
+      for (std::size_t q = 0; q < got; ++q)
+        if (m_labels.unit_flip.at(m_words[q]))
+          m_point_labels[q] = Label(-m_point_labels[q]);
     }
     if (m_labels.point_flip)
       for (std::size_t q = 0; q < got; ++q)

@@ -1,0 +1,274 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_STREAMING_PATCH_UNITS_H
+#define NORMAL_ORIENTATION_STREAMING_PATCH_UNITS_H
+
+/// \file Patch_units.h
+/// The units of the streamed global stage's patches, and the graph between
+/// them, built in one pass over the labelled points and the sweep's edge
+/// file: the patches of every level are unions of units, as the in-core
+/// patches are unions of points (`build_patches()`).
+
+#include <Normal_orientation/internal/Core_global_sign.h>
+#include <Normal_orientation/streaming/Refinement.h>
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+namespace Normal_orientation {
+namespace streaming {
+/// \cond SKIP_IN_MANUAL
+namespace internal {
+
+/// The patch units of the points pushed in the sweep order.  A point joins
+/// the provisional sheet of its earlier neighbours across the edges that
+/// `same_sheet()` accepts with the median slope of the edges seen so far
+/// (`patch_slope()`), or starts one; a unit is the points of one final
+/// segment, one provisional sheet and one cell of side `cell`.  Two units
+/// are adjacent when an edge of slope at most `sheet_slope` joins them
+/// within one component with oriented normals within 60 degrees of each
+/// other or of each other's opposite; each adjacency keeps the smallest
+/// slope of either kind.  So a patch of the current signs (`patches()`) is
+/// what `build_patches()` would make of the points, except that a unit is
+/// never split.  Memory: the last `span` points, the units, their
+/// adjacencies and the provisional sheets.  Deterministic.
+class Patch_units
+{
+public:
+  typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
+  /// the side of a coarse cell (level 1 of `patches()`), in cells
+  static constexpr int coarse_factor = 3;
+
+  /// for edges reaching at most `span` points back and cells of side `cell` (> 0)
+  Patch_units(std::uint64_t span, double cell) : m_ring(std::size_t(span) + 1), m_cell(cell) {}
+
+  /// The next point in the sweep order: its position, its oriented normal
+  /// (zero: none), its final segment and component, and its earlier edges
+  /// `edges[0 .. count - 1]`; returns its unit.
+  /// \throw std::runtime_error when an edge reaches before the first point or
+  ///        farther back than the span
+  std::uint32_t push(const Kernel::Point_3& p, const Kernel::Vector_3& m, std::uint32_t segment,
+                     std::uint32_t component, const Earlier_edge* edges, std::size_t count)
+  {
+    const bool has_normal = m != CGAL::NULL_VECTOR;
+    std::uint32_t sheet = no_sheet;
+    double slope[64];
+    const std::size_t kept = std::min<std::size_t>(count, 64);
+    for (std::size_t e = 0; e < count && has_normal; ++e) {
+      const Point& o = earlier(edges[e].offset);
+      const double s = o.has_normal ? Normal_orientation::internal::edge_slope(p, o.position, m, o.normal) : 2.0;
+      if (e < kept)
+        slope[e] = s;
+      if (!o.has_normal || o.component != component ||
+          !Normal_orientation::internal::same_sheet(m, o.normal, float(s), m_split_slope))
+        continue;
+      if (sheet == no_sheet)
+        sheet = find(o.sheet);
+      else
+        sheet = unite(sheet, o.sheet);
+    }
+    if (sheet == no_sheet) {
+      sheet = std::uint32_t(m_sheet_parent.size());
+      m_sheet_parent.push_back(sheet);
+    }
+    const std::uint32_t unit = unit_of(p, segment, sheet, component);
+    for (std::size_t e = 0; e < count && has_normal; ++e) {
+      const Point& o = earlier(edges[e].offset);
+      if (!o.has_normal)
+        continue;
+      const double s = e < kept ? slope[e] : Normal_orientation::internal::edge_slope(p, o.position, m, o.normal);
+      ++m_histogram[std::min<std::size_t>(m_histogram.size() - 1, std::size_t(s * double(m_histogram.size())))];
+      if (o.unit == unit || o.component != component || s > Normal_orientation::internal::sheet_slope)
+        continue;
+      const double dot = CGAL::to_double(m * o.normal);
+      if (dot > -0.5 && dot < 0.5)
+        continue;
+      const std::uint32_t a = std::min(unit, o.unit), b = std::max(unit, o.unit);
+      auto it = m_pairs.emplace((std::uint64_t(a) << 32) | b, std::array<float, 2>{{2.0f, 2.0f}}).first;
+      float& least = it->second[dot >= 0.5 ? 0 : 1];
+      least = std::min(least, float(s));
+    }
+    Point& slot = m_ring[std::size_t(m_at % m_ring.size())];
+    slot.position = p;
+    slot.normal = m;
+    slot.unit = unit;
+    slot.sheet = sheet;
+    slot.component = component;
+    slot.has_normal = has_normal;
+    if (++m_at % 4096 == 0)
+      m_split_slope = patch_slope();
+    return unit;
+  }
+
+  /// the number of units
+  std::size_t number_of_units() const { return m_unit_segment.size(); }
+  /// the final segment of every unit
+  const std::vector<std::uint32_t>& unit_segment() const { return m_unit_segment; }
+  /// the component of every unit
+  const std::vector<std::uint32_t>& unit_component() const { return m_unit_component; }
+
+  /// The patches of the units with the negations `flip` (per unit, relative
+  /// to the orientation pushed): the units united across their adjacencies
+  /// whose oriented normals agree after the negations with a slope of at
+  /// most `max_slope`, within one cell of `level` (0: anywhere, 1: a coarse
+  /// cell, 2: a cell), numbered 0, 1, ... by their first unit.
+  std::vector<std::uint32_t> patches(const std::vector<char>& flip, double max_slope, int level) const
+  {
+    std::vector<std::uint32_t> parent(flip.size());
+    for (std::size_t u = 0; u < parent.size(); ++u)
+      parent[u] = std::uint32_t(u);
+    auto root = [&parent](std::uint32_t u) {
+      while (parent[u] != u)
+        u = parent[u] = parent[parent[u]];
+      return u;
+    };
+    // (in key order, so that the roots do not depend on the hash table's)
+    std::vector<std::uint64_t> keys;
+    keys.reserve(m_pairs.size());
+    for (const auto& pair : m_pairs)
+      if (double(pair.second[0]) <= max_slope || double(pair.second[1]) <= max_slope)
+        keys.push_back(pair.first);
+    std::sort(keys.begin(), keys.end());
+    for (std::uint64_t key : keys) {
+      const std::uint32_t a = std::uint32_t(key >> 32), b = std::uint32_t(key & 0xFFFFFFFFu);
+      if (double(m_pairs.at(key)[flip[a] != flip[b] ? 1 : 0]) > max_slope)
+        continue;
+      if (level != 0 && !same_cell(a, b, level == 1 ? coarse_factor : 1))
+        continue;
+      const std::uint32_t ra = root(a), rb = root(b);
+      if (ra != rb)
+        parent[std::max(ra, rb)] = std::min(ra, rb);
+    }
+    const std::uint32_t unset = ~std::uint32_t(0);
+    std::vector<std::uint32_t> id(flip.size(), unset), patch(flip.size());
+    std::uint32_t next = 0;
+    for (std::size_t u = 0; u < patch.size(); ++u) {
+      const std::uint32_t r = root(std::uint32_t(u));
+      if (id[r] == unset)
+        id[r] = next++;
+      patch[u] = id[r];
+    }
+    return patch;
+  }
+
+  /// the median slope of the edges pushed, within [`patch_slope_floor`,
+  /// `sheet_slope`], as `patch_slope()` of the in-core graph
+  double patch_slope() const
+  {
+    std::uint64_t total = 0, below = 0;
+    for (std::uint64_t c : m_histogram)
+      total += c;
+    if (total == 0)
+      return Normal_orientation::internal::sheet_slope;
+    std::size_t b = 0;
+    for (; b + 1 < m_histogram.size(); ++b) {
+      below += m_histogram[b];
+      if (2 * below > total)
+        break;
+    }
+    const double median = (double(b) + 0.5) / double(m_histogram.size());
+    return std::min(Normal_orientation::internal::sheet_slope,
+                    std::max(Normal_orientation::internal::patch_slope_floor, median));
+  }
+
+private:
+  static constexpr std::uint32_t no_sheet = ~std::uint32_t(0);
+
+  struct Point
+  {
+    Kernel::Point_3 position;
+    Kernel::Vector_3 normal;
+    std::uint32_t unit = 0, sheet = 0, component = 0;
+    bool has_normal = false;
+  };
+  typedef std::pair<std::uint64_t, std::uint64_t> Key;
+  struct Key_hash
+  {
+    std::size_t operator()(const Key& k) const
+    {
+      return std::size_t((k.first * 0x9E3779B97F4A7C15ull) ^ (k.second * 0xC2B2AE3D27D4EB4Full));
+    }
+  };
+
+  const Point& earlier(std::uint64_t back) const
+  {
+    if (back == 0 || back > m_at || back >= m_ring.size())
+      throw std::runtime_error("streaming_orient_normals: an edge of the edge file reaches beyond its span");
+    return m_ring[std::size_t((m_at - back) % m_ring.size())];
+  }
+
+  std::uint32_t find(std::uint32_t s)
+  {
+    while (m_sheet_parent[s] != s)
+      s = m_sheet_parent[s] = m_sheet_parent[m_sheet_parent[s]];
+    return s;
+  }
+  std::uint32_t unite(std::uint32_t a, std::uint32_t b)
+  {
+    a = find(a);
+    b = find(b);
+    m_sheet_parent[std::max(a, b)] = std::min(a, b);
+    return std::min(a, b);
+  }
+
+  std::uint32_t unit_of(const Kernel::Point_3& p, std::uint32_t segment, std::uint32_t sheet, std::uint32_t component)
+  {
+    std::array<std::int32_t, 3> c;
+    std::uint64_t packed = 0;
+    for (int d = 0; d < 3; ++d) {
+      c[d] = std::int32_t(std::max(-1e9, std::min(1e9, std::floor(CGAL::to_double(p[d]) / m_cell))));
+      packed = (packed << 21) | (std::uint64_t(std::int64_t(c[d])) & 0x1FFFFF);
+    }
+    const Key key((std::uint64_t(sheet) << 32) | segment, packed);
+    if (m_at > 0 && key == m_last_key)
+      return m_last_unit;
+    const auto ins = m_units.emplace(key, std::uint32_t(m_unit_segment.size()));
+    if (ins.second) {
+      if (m_unit_segment.size() == std::size_t(no_sheet))
+        throw std::length_error("streaming_orient_normals: too many patch units");
+      m_unit_cell.push_back(c);
+      m_unit_segment.push_back(segment);
+      m_unit_component.push_back(component);
+    }
+    m_last_key = key;
+    m_last_unit = ins.first->second;
+    return m_last_unit;
+  }
+
+  bool same_cell(std::uint32_t a, std::uint32_t b, int factor) const
+  {
+    auto coarse = [factor](std::int32_t c) { return c >= 0 ? c / factor : -((-c + factor - 1) / factor); };
+    for (int d = 0; d < 3; ++d)
+      if (coarse(m_unit_cell[a][d]) != coarse(m_unit_cell[b][d]))
+        return false;
+    return true;
+  }
+
+  std::vector<Point> m_ring;
+  double m_cell;
+  std::uint64_t m_at = 0;
+  double m_split_slope = Normal_orientation::internal::sheet_slope;
+  std::array<std::uint64_t, 1024> m_histogram{};
+  std::vector<std::uint32_t> m_sheet_parent;
+  std::unordered_map<Key, std::uint32_t, Key_hash> m_units;
+  Key m_last_key;
+  std::uint32_t m_last_unit = 0;
+  std::vector<std::array<std::int32_t, 3>> m_unit_cell;
+  std::vector<std::uint32_t> m_unit_segment, m_unit_component;
+  std::unordered_map<std::uint64_t, std::array<float, 2>> m_pairs;
+};
+
+} // namespace internal
+/// \endcond
+} // namespace streaming
+} // namespace Normal_orientation
+
+#endif // NORMAL_ORIENTATION_STREAMING_PATCH_UNITS_H
