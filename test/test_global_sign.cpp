@@ -869,6 +869,13 @@ TEST(Patch_units, UnitsFollowTheSheetsAcrossSegments)
   EXPECT_NE(of_part[0][0], of_part[1][0]);
   EXPECT_NE(of_part[0][0], of_part[2][0]);
   EXPECT_NE(of_part[1][0], of_part[2][0]);
+  // Beyond the maximum number of units, the units overflow and stop growing.
+  EXPECT_FALSE(units.overflowed());
+  NO::streaming::internal::Patch_units few(span, 4.0, 3);
+  for (std::size_t t = 0; t < order.size() && !few.overflowed(); ++t)
+    few.push(points[order[t]], up, std::uint32_t(points[order[t]].x() / 7.0), 0, earlier[t].data(), earlier[t].size());
+  EXPECT_TRUE(few.overflowed());
+  EXPECT_LE(few.number_of_units(), 3u);
   // An edge reaching farther back than the span is an error.
   NO::streaming::internal::Patch_units short_units(1, 1.0);
   const NO::streaming::Earlier_edge far{2, 1.0f};

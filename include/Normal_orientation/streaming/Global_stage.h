@@ -378,6 +378,10 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   }
   Global_samples<Kernel> samples = collect_global_samples<Kernel>(points, component, flip_component, stride,
                                                                   units.get(), unit_inputs.edges, unit_file.get());
+  if (units && units->overflowed()) { // (noise: segments of a few points) as without an edge file
+    units.reset();
+    unit_file.reset();
+  }
   progress.report(1, 4);
   Global_sign_summary report;
   const std::size_t ns = samples.points.size();

@@ -39,7 +39,8 @@ namespace internal {
 /// slope of either kind.  So a patch of the current signs (`patches()`) is
 /// what `build_patches()` would make of the points, except that a unit is
 /// never split.  Memory: the last `span` points, the units, their
-/// adjacencies and the provisional sheets.  Deterministic.
+/// adjacencies (at most `maximum_units` units) and the provisional sheets.
+/// Deterministic.
 class Patch_units
 {
 public:
@@ -47,8 +48,16 @@ public:
   /// the side of a coarse cell (level 1 of `patches()`), in cells
   static constexpr int coarse_factor = 3;
 
-  /// for edges reaching at most `span` points back and cells of side `cell` (> 0)
-  Patch_units(std::uint64_t span, double cell) : m_ring(std::size_t(span) + 1), m_cell(cell) {}
+  /// for edges reaching at most `span` points back, cells of side `cell`
+  /// (> 0) and at most `maximum_units` units (beyond, `overflowed()`)
+  Patch_units(std::uint64_t span, double cell, std::size_t maximum_units = std::size_t(1) << 18)
+    : m_ring(std::size_t(span) + 1), m_cell(cell), m_maximum_units(maximum_units)
+  {
+  }
+
+  /// whether the points needed more than the maximum number of units: then
+  /// the units and their adjacencies stop growing, and are not to be used
+  bool overflowed() const { return m_overflowed; }
 
   /// The next point in the sweep order: its position, its oriented normal
   /// (zero: none), its final segment and component, and its earlier edges
@@ -80,7 +89,7 @@ public:
       m_sheet_parent.push_back(sheet);
     }
     const std::uint32_t unit = unit_of(p, segment, sheet, component);
-    for (std::size_t e = 0; e < count && has_normal; ++e) {
+    for (std::size_t e = 0; e < count && has_normal && !m_overflowed; ++e) {
       const Point& o = earlier(edges[e].offset);
       if (!o.has_normal)
         continue;
@@ -230,10 +239,16 @@ private:
     const Key key((std::uint64_t(sheet) << 32) | segment, packed);
     if (m_at > 0 && key == m_last_key)
       return m_last_unit;
+    if (m_overflowed)
+      return 0;
+    if (m_unit_segment.size() >= m_maximum_units && m_units.find(key) == m_units.end()) {
+      m_overflowed = true;
+      m_units.clear();
+      m_pairs.clear();
+      return 0;
+    }
     const auto ins = m_units.emplace(key, std::uint32_t(m_unit_segment.size()));
     if (ins.second) {
-      if (m_unit_segment.size() == std::size_t(no_sheet))
-        throw std::length_error("streaming_orient_normals: too many patch units");
       m_unit_cell.push_back(c);
       m_unit_segment.push_back(segment);
       m_unit_component.push_back(component);
@@ -254,6 +269,8 @@ private:
 
   std::vector<Point> m_ring;
   double m_cell;
+  std::size_t m_maximum_units;
+  bool m_overflowed = false;
   std::uint64_t m_at = 0;
   double m_split_slope = Normal_orientation::internal::sheet_slope;
   std::array<std::uint64_t, 1024> m_histogram{};
