@@ -708,6 +708,14 @@ void two_layers(std::size_t n, double h, double gap, std::vector<Point>& points,
       }
 }
 
+/// `two_layers()` of spacing 1 and its 12-neighbour graph
+void two_layer_graph(std::size_t n, double gap, std::vector<Point>& points, std::vector<Vector>& normals,
+                     NO::Neighbor_graph& graph)
+{
+  two_layers(n, 1.0, gap, points, normals);
+  NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(points, normals, 12, 0.0, NO::Hoppe_criterion(), graph);
+}
+
 /// the points and the normals of `cloud`, apart
 void split_cloud(const std::vector<Point_with_normal>& cloud, std::vector<Point>& points, std::vector<Vector>& normals)
 {
@@ -745,9 +753,8 @@ TEST(Global_sign, PatchesSeparateLayersCloserThanTheSpacing)
   // patch_slope() is tested on a whole surface below.)
   std::vector<Point> points;
   std::vector<Vector> normals;
-  two_layers(900, 1.0, 0.5, points, normals);
   NO::Neighbor_graph graph;
-  NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(points, normals, 12, 0.0, NO::Hoppe_criterion(), graph);
+  two_layer_graph(900, 0.5, points, normals, graph);
   std::size_t across = 0;
   for (auto e : boost::make_iterator_range(edges(graph)))
     across += points[source(e, graph)].z() != points[target(e, graph)].z() ? 1 : 0;
@@ -788,9 +795,8 @@ TEST(Patch_units, UnitsFollowTheSheetsAcrossSegments)
   // per layer where half of one layer is negated.
   std::vector<Point> points;
   std::vector<Vector> normals;
-  two_layers(2500, 1.0, 1.5, points, normals);
   NO::Neighbor_graph graph;
-  NO::build_neighbor_graph<CGAL::Sequential_tag, Kernel>(points, normals, 12, 0.0, NO::Hoppe_criterion(), graph);
+  two_layer_graph(2500, 1.5, points, normals, graph);
   std::vector<std::size_t> order(points.size());
   for (std::size_t i = 0; i < order.size(); ++i)
     order[i] = i;

@@ -935,6 +935,13 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
     EXPECT_LE(double(o.streamed) / n, c.streamed) << c.name;
     EXPECT_LE(double(o.core) / n, c.core) << c.name;
   }
+  // PCA normals of 18 neighbours, as make_hard_cloud estimates them
+  auto pca_normals = [](std::vector<std::pair<Point, Vector>>& input) {
+    CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
+      input, 18,
+      CGAL::parameters::point_map(CGAL::First_of_pair_property_map<std::pair<Point, Vector>>())
+        .normal_map(CGAL::Second_of_pair_property_map<std::pair<Point, Vector>>()));
+  };
   // A street between two facades with PCA normals (one sheet across the
   // rounded creases): its ground faces up, streamed as in core, and so do
   // the facades that the solver ties to it.
@@ -942,10 +949,7 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
     std::mt19937_64 g(41);
     const auto truth = NO::hard_shapes::street_canyon(20000, g);
     auto input = unoriented(truth, g);
-    CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
-      input, 18,
-      CGAL::parameters::point_map(CGAL::First_of_pair_property_map<std::pair<Point, Vector>>())
-        .normal_map(CGAL::Second_of_pair_property_map<std::pair<Point, Vector>>()));
+    pca_normals(input);
     const Both o = both(input, truth);
     const double n = double(truth.size());
     std::printf("street_canyon (PCA)  wrong streamed %6.2f%%, in core %6.2f%%\n", 100.0 * double(o.streamed) / n,
@@ -970,10 +974,7 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
     std::normal_distribution<double> noise(0.0, 0.002 * diagonal);
     for (auto& pn : input)
       pn.first = Point(pn.first.x() + noise(g), pn.first.y() + noise(g), pn.first.z() + noise(g));
-    CGAL::pca_estimate_normals<CGAL::Sequential_tag>(
-      input, 18,
-      CGAL::parameters::point_map(CGAL::First_of_pair_property_map<std::pair<Point, Vector>>())
-        .normal_map(CGAL::Second_of_pair_property_map<std::pair<Point, Vector>>()));
+    pca_normals(input);
     const Both o = both(input, truth);
     const double n = double(truth.size());
     std::printf("%s, noise 0.2%%: wrong streamed %6.2f%%, in core %6.2f%%\n", name, 100.0 * double(o.streamed) / n,
