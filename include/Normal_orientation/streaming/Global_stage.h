@@ -250,10 +250,10 @@ Stream_seen_sides stream_seen_sides(const Global_samples<Kernel>& samples, const
   if (units) {
     out.unit_sheet = units->patches(std::vector<char>(units->number_of_units(), 0),
                                     Normal_orientation::internal::sheet_slope, 0);
-    for (std::size_t j = 0; j < ns; ++j) {
+    for (std::uint32_t id : out.unit_sheet) // (every unit's, sampled or not)
+      out.number_of_sheets = std::max<std::size_t>(out.number_of_sheets, std::size_t(id) + 1);
+    for (std::size_t j = 0; j < ns; ++j)
       out.sheet.push_back(out.unit_sheet[samples.unit[j]]);
-      out.number_of_sheets = std::max<std::size_t>(out.number_of_sheets, std::size_t(out.sheet.back()) + 1);
-    }
   } else {
     out.sheet = segment_patch;
     out.number_of_sheets = number_of_segments;
