@@ -299,7 +299,8 @@ Stream_seen_sides stream_seen_sides(const Global_samples<Kernel>& samples, const
 template <typename ConcurrencyTag, typename Kernel>
 void stream_winding_levels(const Global_samples<Kernel>& samples, Winding_patch_signs<Kernel>& search,
                            const Patch_units* units, const std::vector<std::uint32_t>& segment_patch,
-                           std::size_t number_of_segments, double radius, const std::vector<char>& has_unary,
+                           const std::vector<std::uint32_t>& segment_first, double radius,
+                           const std::vector<char>& has_unary,
                            std::vector<char>& sample_flip, std::vector<char>& unit_flip, Global_sign_summary& report)
 {
   const std::size_t ns = samples.points.size();
@@ -316,9 +317,7 @@ void stream_winding_levels(const Global_samples<Kernel>& samples, Winding_patch_
       patch = segment_patches(samples.points, ids, 0.0, first);
     } else if (cell_radii == 0.0) {
       patch = segment_patch;
-      first.resize(number_of_segments);
-      for (std::size_t j = ns; j-- > 0;)
-        first[segment_patch[j]] = std::uint32_t(j);
+      first = segment_first;
     } else {
       patch = segment_patches(samples.points, samples.segment, cell_radii * radius, first);
     }
@@ -410,7 +409,7 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
       oriented[j] = -oriented[j];
   Winding_patch_signs<Kernel> search;
   search.template build<ConcurrencyTag>(samples.points, oriented, areas);
-  stream_winding_levels<ConcurrencyTag>(samples, search, units.get(), segment_patch, segment_first.size(), radius,
+  stream_winding_levels<ConcurrencyTag>(samples, search, units.get(), segment_patch, segment_first, radius,
                                         has_unary, sample_flip, unit_flip, report);
   // The winding number's flips against both the solver and visibility, in
   // the sheets they turn away from where they were seen, are undone.

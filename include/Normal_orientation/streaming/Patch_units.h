@@ -9,6 +9,7 @@
 /// file: the patches of every level are unions of units, as the in-core
 /// patches are unions of points (`build_patches()`).
 
+#include <Normal_orientation/Signed_union_find.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/streaming/Refinement.h>
 
@@ -131,36 +132,22 @@ public:
   /// cell, 2: a cell), numbered 0, 1, ... by their first unit.
   std::vector<std::uint32_t> patches(const std::vector<char>& flip, double max_slope, int level) const
   {
-    std::vector<std::uint32_t> parent(flip.size());
-    for (std::size_t u = 0; u < parent.size(); ++u)
-      parent[u] = std::uint32_t(u);
-    auto root = [&parent](std::uint32_t u) {
-      while (parent[u] != u)
-        u = parent[u] = parent[parent[u]];
-      return u;
-    };
-    // (in key order, so that the roots do not depend on the hash table's)
-    std::vector<std::uint64_t> keys;
-    keys.reserve(m_pairs.size());
-    for (const auto& pair : m_pairs)
-      if (double(pair.second[0]) <= max_slope || double(pair.second[1]) <= max_slope)
-        keys.push_back(pair.first);
-    std::sort(keys.begin(), keys.end());
-    for (std::uint64_t key : keys) {
-      const std::uint32_t a = std::uint32_t(key >> 32), b = std::uint32_t(key & 0xFFFFFFFFu);
-      if (double(m_pairs.at(key)[flip[a] != flip[b] ? 1 : 0]) > max_slope)
+    // (the sets do not depend on the order of the unions; their numbers,
+    // by first unit, do not depend on the roots)
+    Signed_union_find sets(flip.size());
+    for (const auto& pair : m_pairs) {
+      const std::uint32_t a = std::uint32_t(pair.first >> 32), b = std::uint32_t(pair.first & 0xFFFFFFFFu);
+      if (double(pair.second[flip[a] != flip[b] ? 1 : 0]) > max_slope)
         continue;
       if (level != 0 && !same_cell(a, b, level == 1 ? coarse_factor : 1))
         continue;
-      const std::uint32_t ra = root(a), rb = root(b);
-      if (ra != rb)
-        parent[std::max(ra, rb)] = std::min(ra, rb);
+      sets.unite(a, b);
     }
     const std::uint32_t unset = ~std::uint32_t(0);
     std::vector<std::uint32_t> id(flip.size(), unset), patch(flip.size());
     std::uint32_t next = 0;
     for (std::size_t u = 0; u < patch.size(); ++u) {
-      const std::uint32_t r = root(std::uint32_t(u));
+      const std::uint32_t r = sets.find(Signed_union_find::Index(u));
       if (id[r] == unset)
         id[r] = next++;
       patch[u] = id[r];
