@@ -119,7 +119,9 @@ auto with_criterion_and_solver(const Cli::Options& o, const F& f)
     return with_solver(NO::Xie_criterion());
   if (o.criterion == "konig")
     return with_solver(NO::Konig_criterion());
-  return with_solver(NO::Hoppe_criterion());
+  if (o.criterion == "hoppe")
+    return with_solver(NO::Hoppe_criterion());
+  return with_solver(NO::Hoppe_konig_criterion());
 }
 
 // ---------------------------------------------------------------------------

@@ -94,9 +94,54 @@ TEST(Flip_criteria, KonigValues)
   EXPECT_LT(phi(a, V(1, 0, 0), b, V(0, 0, -1)), -0.3);
 }
 
+TEST(Flip_criteria, HoppeKonigValues)
+{
+  NO::Hoppe_konig_criterion phi;
+  const NO::Hoppe_criterion hoppe;
+  const NO::Konig_criterion konig;
+  // nearly parallel normals: Hoppe's, whatever König's says
+  const P a(0, 0, 0), b(0.1, 0, 0.08);
+  const V na(0, 0, 1), nb(0.2, 0, 1);
+  EXPECT_EQ(phi(a, na, b, nb), hoppe(a, na, b, nb));
+  // a thin slab: Hoppe's (sure, and wrong there), as in the default pipeline
+  EXPECT_EQ(phi(P(0, 0, 0.05), V(0, 0, 1), P(0.01, 0, -0.05), V(0, 0, -1)),
+            hoppe(P(0, 0, 0.05), V(0, 0, 1), P(0.01, 0, -0.05), V(0, 0, -1)));
+  // a 90-degree crease: Hoppe's says nothing, König's decides
+  const P c(1, 0, 0.9), d(0.9, 0, 1);
+  EXPECT_EQ(phi(c, V(1, 0, 0), d, V(0, 0, 1)), konig(c, V(1, 0, 0), d, V(0, 0, 1)));
+  EXPECT_GT(phi(c, V(1, 0, 0), d, V(0, 0, 1)), 0.3);
+  EXPECT_LT(phi(c, V(1, 0, 0), d, V(0, 0, -1)), -0.3);
+  // random edges: Hoppe's where it is sure or König's is not surer, else König's
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int hoppe_kept = 0, konig_taken = 0;
+  for (int t = 0; t < 2000; ++t) {
+    const P p(u(rng), u(rng), u(rng)), q(u(rng), u(rng), u(rng));
+    const V m = random_unit(rng), n = random_unit(rng);
+    const double h = hoppe(p, m, q, n), k = konig(p, m, q, n), f = phi(p, m, q, n);
+    if (std::abs(h) >= 0.5 || std::abs(k) <= std::abs(h)) {
+      EXPECT_EQ(f, h);
+      ++hoppe_kept;
+    } else {
+      EXPECT_EQ(f, k);
+      ++konig_taken;
+    }
+  }
+  EXPECT_GT(hoppe_kept, 100);
+  EXPECT_GT(konig_taken, 100);
+  // the limit: 0 is Hoppe's criterion
+  EXPECT_EQ(NO::Hoppe_konig_criterion(0.0)(c, V(1, 0, 0), d, V(0, 0, 1)), hoppe(c, V(1, 0, 0), d, V(0, 0, 1)));
+  EXPECT_STREQ(NO::Hoppe_konig_criterion::name(), "hoppe-konig");
+}
+
 TEST(Flip_criteria, AxiomsHoppe) { check_criterion_axioms(NO::Hoppe_criterion(), 1); }
 TEST(Flip_criteria, AxiomsXie) { check_criterion_axioms(NO::Xie_criterion(), 2); }
 TEST(Flip_criteria, AxiomsKonig) { check_criterion_axioms(NO::Konig_criterion(), 3); }
+TEST(Flip_criteria, AxiomsHoppeKonig)
+{
+  check_criterion_axioms(NO::Hoppe_konig_criterion(), 4);
+  check_criterion_axioms(NO::Hoppe_konig_criterion(2.0), 5);
+}
 
 TEST(Energy, EdgeTermsFollowEquation2)
 {

@@ -57,14 +57,15 @@ auto pwn_params()
     .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>());
 }
 
-/// orient_normals with the given global stage; returns the wrong count
+/// orient_normals with the given global stage and Hoppe's criterion; returns the wrong count
 std::size_t orient_and_count(const std::vector<Sample>& truth, NO::Global_orientation global, unsigned seed,
                              NO::Orientation_result* result = nullptr)
 {
   std::mt19937_64 rng(seed);
   std::vector<Point_with_normal> cloud = NO::test::unoriented(truth, rng);
+  // Hoppe's criterion: the local energy whose failures the stage is for
   const NO::Orientation_result r =
-    NO::orient_normals(cloud, pwn_params().global_orientation(global));
+    NO::orient_normals(cloud, pwn_params().global_orientation(global).flip_criterion(NO::Hoppe_criterion()));
   if (result)
     *result = r;
   return NO::test::count_wrong(truth, cloud);

@@ -196,7 +196,7 @@ double in_core_energy(const std::vector<Point_record>& in, const std::vector<Poi
     position[in[i].index] = i;
   }
   NO::Neighbor_graph graph;
-  NO::build_neighbor_graph<CGAL::Sequential_tag, K>(points, normals, k, radius, NO::Hoppe_criterion(), graph,
+  NO::build_neighbor_graph<CGAL::Sequential_tag, K>(points, normals, k, radius, NO::Hoppe_konig_criterion(), graph, // the default
                                                     NO::Progress_reporter());
   std::vector<NO::Label> labels(in.size(), NO::Label(1));
   for (const Point_record& r : out) {

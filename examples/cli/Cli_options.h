@@ -36,7 +36,7 @@ struct Options
   std::string input, output; ///< IN and OUT
   unsigned int k = Normal_orientation::default_number_of_neighbors; ///< --k
   double radius = 0.0;                 ///< --radius (0: estimated)
-  std::string criterion = "hoppe";     ///< --criterion
+  std::string criterion = "hoppe-konig"; ///< --criterion
   std::string solver = "qpbo-i";       ///< --solver
   unsigned int orders = 3;             ///< --orders
   std::string sign = "outward";        ///< --sign
@@ -79,7 +79,8 @@ inline const char* usage_text()
          "options:\n"
          "  --k N                neighbours per point (default 12)\n"
          "  --radius R           neighbour radius (default: estimated from the data)\n"
-         "  --criterion NAME     flip criterion: hoppe (default), xie, konig\n"
+         "  --criterion NAME     flip criterion: hoppe-konig (default: Hoppe's, and Konig's where\n"
+         "                       the normals are over 60 degrees apart and it is surer), hoppe, xie, konig\n"
          "  --solver NAME        solver: qpbo-i (default: MST, then QPBO-I on the segment graph),\n"
          "                       mst (fastest), lsa-tr\n"
          "  --orders N           qpbo-i: random orders tried, the best is kept (default 3)\n"
@@ -187,8 +188,8 @@ bool read_option(Options& o, const std::string& a, const Value& value)
       throw Usage_error("--radius must be a number > 0");
   } else if (a == "--criterion") {
     o.criterion = value();
-    if (o.criterion != "hoppe" && o.criterion != "xie" && o.criterion != "konig")
-      throw Usage_error("unknown criterion '" + o.criterion + "' (hoppe, xie, konig)");
+    if (o.criterion != "hoppe-konig" && o.criterion != "hoppe" && o.criterion != "xie" && o.criterion != "konig")
+      throw Usage_error("unknown criterion '" + o.criterion + "' (hoppe-konig, hoppe, xie, konig)");
   } else if (a == "--solver") {
     o.solver = value();
     if (o.solver != "mst" && o.solver != "qpbo-i" && o.solver != "lsa-tr")

@@ -137,6 +137,37 @@ struct Konig_criterion
   static const char* name() { return "konig"; }
 };
 
+/// \ingroup PkgNormalOrientationCriteria
+/// Hoppe's criterion, with König and Gumhold's where Hoppe's is unsure and
+/// König's is surer (the default): phi = phi_H when |phi_H| >= `hoppe_limit`,
+/// else whichever of phi_H and phi_K has the larger magnitude (phi_H when
+/// they are equal).  Between normals nearly parallel, which is where noise
+/// puts most edges, it is Hoppe's criterion, and König's curves, which noise
+/// wider than the spacing makes unreliable, are not even computed.  At a
+/// sharp crease (normals at a right angle, phi_H near 0), the curves decide.
+/// \cgalModels `FlipCriterion`
+struct Hoppe_konig_criterion
+{
+  /// `hoppe_limit` in [0, 1]: below this |phi_H|, König's criterion is
+  /// consulted (0: Hoppe's criterion; above 1: the larger of the two everywhere)
+  explicit Hoppe_konig_criterion(double hoppe_limit = 0.5) : hoppe_limit(hoppe_limit) {}
+
+  /// returns phi in [-1, 1] for the edge (p_i, n_i)-(p_j, n_j)
+  template <typename Point, typename Vector>
+  double operator()(const Point& p_i, const Vector& n_i, const Point& p_j, const Vector& n_j) const
+  {
+    const double h = Hoppe_criterion()(p_i, n_i, p_j, n_j);
+    if (!(std::abs(h) < hoppe_limit))
+      return h;
+    const double k = Konig_criterion()(p_i, n_i, p_j, n_j);
+    return std::abs(k) > std::abs(h) ? k : h;
+  }
+  /// the name used on the command line and in reports
+  static const char* name() { return "hoppe-konig"; }
+
+  double hoppe_limit; ///< below this |phi_H|, König's criterion is consulted
+};
+
 } // namespace Normal_orientation
 
 #endif // NORMAL_ORIENTATION_FLIP_CRITERIA_H

@@ -76,7 +76,7 @@ struct Policies
 
 /// The flip criterion, the solver, the component sign policy and the
 /// global stage of `np`, with the defaults of both drivers:
-/// `Hoppe_criterion`, `Qpbo_i_solver(3, seed)`, `Outward_component_sign`
+/// `Hoppe_konig_criterion`, `Qpbo_i_solver(3, seed)`, `Outward_component_sign`
 /// (or `Constrained_component_sign<>` when there are constraints), and
 /// `Global_orientation::VISIBILITY_AND_WINDING` when the sign policy is the
 /// default and there are no constraints or priors (which say what the user
@@ -89,7 +89,7 @@ auto read_policies(const NamedParameters& np, unsigned long seed)
   typedef std::conditional_t<Unary_parameters<NamedParameters>::has_constraints, Constrained_component_sign<>,
                              Outward_component_sign>
     Default_sign;
-  auto criterion = choose_parameter(get_parameter(np, internal_np::flip_criterion), Hoppe_criterion());
+  auto criterion = choose_parameter(get_parameter(np, internal_np::flip_criterion), Hoppe_konig_criterion());
   auto solver = choose_parameter(get_parameter(np, internal_np::solver), Qpbo_i_solver(3, seed));
   auto sign_policy = choose_parameter(get_parameter(np, internal_np::component_sign), Default_sign());
   constexpr bool user_signs = Unary_parameters<NamedParameters>::has_constraints
@@ -310,7 +310,7 @@ Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, Weig
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{flip_criterion}
 ///     \cgalParamDescription{a model of `FlipCriterion`}
-///     \cgalParamDefault{`Hoppe_criterion()`}
+///     \cgalParamDefault{`Hoppe_konig_criterion()`}
 ///   \cgalParamNEnd
 ///   \cgalParamNBegin{solver}
 ///     \cgalParamDescription{a model of `OrientationSolver`}
