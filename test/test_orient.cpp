@@ -143,9 +143,12 @@ TEST(Orient_normals, ThinSlabDefeatsHoppe)
   const auto truth = box(24000, rng, 2.0, 2.0, 0.06);
   auto cloud = unoriented(truth, rng);
   // (without the global stage, which puts most of it right)
-  const auto wrong =
-    orient_and_count(truth, cloud, pn_params().number_of_neighbors(30).global_orientation(NO::Global_orientation::NONE));
+  const auto params = pn_params().number_of_neighbors(30).global_orientation(NO::Global_orientation::NONE);
+  const auto wrong = orient_and_count(truth, cloud, params.flip_criterion(NO::Hoppe_criterion()));
   EXPECT_GT(wrong, truth.size() / 20);
+  // the default takes König's curves on this small clean cloud, and they see the slab
+  auto again = unoriented(truth, rng);
+  EXPECT_LE(orient_and_count(truth, again, params), truth.size() / 100);
 }
 
 TEST(Orient_normals, InputOrderAndNormalMagnitudesAreKept)
@@ -880,6 +883,78 @@ TEST(Streaming_orient_normals, NoiseWiderThanTheSpacingAsInCore)
   ASSERT_EQ(out.size(), truth.size());
   for (const NO::Point_record& a : out)
     EXPECT_GT(Vector(a.normal[0], a.normal[1], a.normal[2]) * truth[a.index].n, 0.0);
+}
+
+TEST(Streaming_orient_normals, CleanPositionsAsInCore)
+{
+  // The default criterion takes König's curves on every edge of a small
+  // cloud whose positions are clean for its spacing (internal/Clean_positions.h):
+  // both drivers measure the same share and decide the same.  A sparse tube
+  // (a few points per circumference, PCA normals) is the case it is for.
+  struct Run
+  {
+    std::size_t streamed = 0, core = 0;
+    double share_streamed = 0.0, share_core = 0.0;
+    bool everywhere_streamed = false, everywhere_core = false;
+  };
+  auto run = [](const std::vector<std::pair<Point, Vector>>& input, const std::vector<Sample>& truth) {
+    Run o;
+    Rewindable_source src{as_records(input)};
+    std::vector<NO::Point_record> out;
+    auto sink = [&](const NO::Point_record& r) { out.push_back(r); };
+    const NO::Streaming_result sr = NO::streaming_orient_normals(src, sink);
+    EXPECT_EQ(out.size(), input.size());
+    for (const auto& r : out)
+      o.streamed += (Vector(r.normal[0], r.normal[1], r.normal[2]) * truth[r.index].n <= 0.0) ? 1 : 0;
+    auto in_core = input;
+    const NO::Orientation_result rc = NO::orient_normals(in_core, pn_params());
+    o.core = count_wrong(truth, in_core);
+    o.share_streamed = sr.konig_disagreement;
+    o.share_core = rc.konig_disagreement;
+    o.everywhere_streamed = sr.konig_everywhere;
+    o.everywhere_core = rc.konig_everywhere;
+    return o;
+  };
+  std::mt19937_64 rng(7);
+  const auto tube = NO::hard_shapes::sparse_tube(4000, rng);
+  const auto tube_input = noisy_cloud(tube, 0.0, 7); // PCA normals, no noise
+  const Run clean = run(tube_input, tube);
+  const double n = double(tube.size());
+  std::printf("sparse tube, 4k: share %.4f, wrong streamed %.2f%%, in core %.2f%%\n", clean.share_core,
+              100.0 * double(clean.streamed) / n, 100.0 * double(clean.core) / n);
+  EXPECT_EQ(clean.share_streamed, clean.share_core);
+  EXPECT_TRUE(clean.everywhere_core);
+  EXPECT_TRUE(clean.everywhere_streamed);
+  EXPECT_LE(double(clean.core) / n, 0.03);
+  EXPECT_LE(double(clean.streamed) / n, 0.03);
+  { // with Hoppe's criterion, nothing is measured, and the tube fails
+    auto in_core = tube_input;
+    const NO::Orientation_result r = NO::orient_normals(in_core, pn_params().flip_criterion(NO::Hoppe_criterion()));
+    EXPECT_TRUE(std::isnan(r.konig_disagreement));
+    EXPECT_FALSE(r.konig_everywhere);
+    std::printf("sparse tube, 4k, Hoppe's criterion: wrong in core %.2f%%\n", 100.0 * double(count_wrong(tube, in_core)) / n);
+  }
+  // noise of about 0.7 spacings on a torus: the share is high, and the
+  // criterion stays Hoppe's where the normals are nearly parallel
+  std::mt19937_64 g(8);
+  const auto ring = torus(20000, g, 1.0, 0.25);
+  const Run noisy = run(noisy_cloud(ring, 0.015, 9), ring);
+  std::printf("noisy torus, 20k: share %.4f, wrong streamed %.2f%%, in core %.2f%%\n", noisy.share_core,
+              100.0 * double(noisy.streamed) / 20000.0, 100.0 * double(noisy.core) / 20000.0);
+  EXPECT_EQ(noisy.share_streamed, noisy.share_core);
+  EXPECT_GE(noisy.share_core, NO::internal::clean_positions_threshold);
+  EXPECT_FALSE(noisy.everywhere_core);
+  EXPECT_FALSE(noisy.everywhere_streamed);
+  // larger clouds are not measured
+  NO::Hoppe_konig_criterion phi;
+  bool measured = false;
+  const NO::internal::Clean_positions c = NO::internal::apply_clean_positions(
+    phi, NO::internal::clean_positions_maximum_points + 1, [&]() { measured = true; return 0.0; });
+  EXPECT_FALSE(measured);
+  EXPECT_TRUE(std::isnan(c.konig_disagreement));
+  EXPECT_FALSE(phi.konig_everywhere);
+  EXPECT_TRUE(NO::internal::apply_clean_positions(phi, 1000, []() { return 0.0; }).konig_everywhere);
+  EXPECT_TRUE(phi.konig_everywhere);
 }
 
 TEST(Streaming_orient_normals, GlobalStageAsInCore)

@@ -128,6 +128,7 @@ inline std::string json_report(const Normal_orientation::Orientation_result& r, 
   j.key("k").integer(r.number_of_neighbors).key("radius").number(r.neighbor_radius);
   j.key("radius_estimated").boolean(r.radius_estimated);
   j.key("criterion").string(r.criterion).key("solver").string(r.solver);
+  j.key("konig_disagreement").number(r.konig_disagreement).key("konig_everywhere").boolean(r.konig_everywhere);
   j.key("component_sign").string(r.component_sign);
   j.key("seed").integer(o.seed).key("threads").integer(o.threads);
   j.key("normals_estimated").boolean(run.normals_estimated());
@@ -195,6 +196,7 @@ inline std::string json_report(const Streamed_run& run, const Options& o)
   j.key("peak_window").integer(r.peak_window).key("k").integer(o.k);
   j.key("radius").number(r.neighbor_radius).key("radius_estimated").boolean(r.radius_estimated);
   j.key("criterion").string(o.criterion).key("solver").string(o.solver).key("threads").integer(o.threads);
+  j.key("konig_disagreement").number(r.konig_disagreement).key("konig_everywhere").boolean(r.konig_everywhere);
   j.key("segment_energy_before").number(r.segment_energy_before);
   j.key("segment_energy_after").number(r.segment_energy_after);
   j.key("refinement_rounds").integer(run.refinement_rounds);

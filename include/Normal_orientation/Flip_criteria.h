@@ -145,6 +145,8 @@ struct Konig_criterion
 /// puts most edges, it is Hoppe's criterion, and König's curves, which noise
 /// wider than the spacing makes unreliable, are not even computed.  At a
 /// sharp crease (normals at a right angle, phi_H near 0), the curves decide.
+/// On small clouds whose positions are clean, the pipelines take König's
+/// criterion on every edge (`konig_everywhere`).
 /// \cgalModels `FlipCriterion`
 struct Hoppe_konig_criterion
 {
@@ -156,6 +158,8 @@ struct Hoppe_konig_criterion
   template <typename Point, typename Vector>
   double operator()(const Point& p_i, const Vector& n_i, const Point& p_j, const Vector& n_j) const
   {
+    if (konig_everywhere)
+      return Konig_criterion()(p_i, n_i, p_j, n_j);
     const double h = Hoppe_criterion()(p_i, n_i, p_j, n_j);
     if (!(std::abs(h) < hoppe_limit))
       return h;
@@ -166,6 +170,10 @@ struct Hoppe_konig_criterion
   static const char* name() { return "hoppe-konig"; }
 
   double hoppe_limit; ///< below this |phi_H|, König's criterion is consulted
+  /// König's criterion on every edge.  Both drivers set it on clouds of at
+  /// most 200,000 points whose positions are clean for their spacing (see
+  /// the manual, "Hoppe's and König's Criteria Together"); false by default.
+  bool konig_everywhere = false;
 };
 
 } // namespace Normal_orientation

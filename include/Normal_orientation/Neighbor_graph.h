@@ -8,6 +8,7 @@
 /// (sec. 3), with the edge weights w_ij = phi(i, j) * omega(p_i, p_j).
 
 #include <Normal_orientation/Progress.h>
+#include <Normal_orientation/internal/Clean_positions.h>
 #include <Normal_orientation/internal/Parallel.h>
 
 #include <CGAL/Kd_tree.h>
@@ -68,6 +69,12 @@ struct Neighbor_graph_report
   double seconds_neighbors = 0.0;
   /// seconds spent in the weights and the graph assembly
   double seconds_graph = 0.0;
+  /// with `Hoppe_konig_criterion`, on clouds of at most 200,000 points: the
+  /// share of nearly parallel neighbours where König's criterion disagrees
+  /// (NaN: not measured), and whether König's criterion was then taken on
+  /// every edge
+  double konig_disagreement = std::numeric_limits<double>::quiet_NaN();
+  bool konig_everywhere = false; ///< see `konig_disagreement`
 };
 
 /// \ingroup PkgNormalOrientationGraph
@@ -304,6 +311,13 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
   report.radius = radius;
   const double r2 = radius * radius;
 
+  // The default criterion on small clean clouds (internal/Clean_positions.h).
+  FlipCriterion phi = criterion;
+  const internal::Clean_positions clean = internal::apply_clean_positions(
+    phi, n, [&]() { return internal::konig_disagreement<ConcurrencyTag>(points, normals, nb, k); });
+  report.konig_disagreement = clean.konig_disagreement;
+  report.konig_everywhere = clean.konig_everywhere;
+
   // Each undirected edge {i, j} is emitted once: by i if j is one of i's
   // neighbours and (i < j or i is not one of j's neighbours).
   auto keeps = [&](std::size_t i, unsigned t) -> bool {
@@ -348,7 +362,7 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
         const double omega = 1.0 - double(d2[i * k + t]) / r2;
         sources[pos] = std::uint32_t(i);
         targets[pos] = j;
-        props[pos].weight = float(criterion(points[i], normals[i], points[j], normals[j]) * omega);
+        props[pos].weight = float(phi(points[i], normals[i], points[j], normals[j]) * omega);
         ++pos;
       }
     }

@@ -63,6 +63,11 @@ struct Orientation_summary
   unsigned int number_of_neighbors = 0;    ///< k used
   double neighbor_radius = 0.0;            ///< r used
   bool radius_estimated = false;           ///< true when r was estimated from the data
+  /// with `Hoppe_konig_criterion`, on clouds of at most 200,000 points: the
+  /// share of nearly parallel neighbours where König's criterion disagrees
+  /// with Hoppe's (NaN: not measured)
+  double konig_disagreement = std::numeric_limits<double>::quiet_NaN();
+  bool konig_everywhere = false;           ///< König's criterion was taken on every edge (clean positions)
   double energy_before = 0.0;              ///< energy (eq. 3) of the point graph with the input orientation
   /// energy of the point graph with the output orientation (streamed: NaN,
   /// not measured, when the global stage negated points)

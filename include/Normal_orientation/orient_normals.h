@@ -427,6 +427,8 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       result.number_of_neighbors = gr.number_of_neighbors;
       result.neighbor_radius = gr.radius;
       result.radius_estimated = gr.radius_estimated;
+      result.konig_disagreement = gr.konig_disagreement;
+      result.konig_everywhere = gr.konig_everywhere;
       result.seconds.neighbors = gr.seconds_neighbors;
       result.seconds.graph = gr.seconds_graph;
       const auto weight = get(&Neighbor_edge::weight, graph);

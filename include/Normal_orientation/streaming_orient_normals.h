@@ -114,16 +114,19 @@ inline Progress_reporter stage_progress(const Progress_reporter& p, Stage stage)
 }
 
 /// The first stages: the scan (count, zero normals, frame or order) and,
-/// when r is not given, its estimate; returns the number of points.
-template <typename ConcurrencyTag, typename Kernel, typename Source>
+/// when r is not given, its estimate; then the rule of clean positions
+/// (internal/Clean_positions.h) on `criterion`, which the sweep is to use;
+/// returns the number of points.
+template <typename ConcurrencyTag, typename Kernel, typename Source, typename FlipCriterion>
 std::uint64_t scan_and_radius_stages(Source& source, const Streaming_settings& settings, int axis, Sweep_frame& frame,
-                                     Streaming_result& result)
+                                     FlipCriterion& criterion, Streaming_result& result)
 {
   using Normal_orientation::internal::seconds_since;
   auto t = std::chrono::steady_clock::now();
   const bool estimate_radius = settings.neighbor_radius == 0.0;
-  Scan_result<typename Kernel::Point_3> scanned = scan<typename Kernel::Point_3>(
-    source, axis, estimate_radius, stage_progress(settings.progress, Stage::SCAN));
+  Scan_result<typename Kernel::Point_3> scanned =
+    scan<typename Kernel::Point_3>(source, axis, estimate_radius, stage_progress(settings.progress, Stage::SCAN),
+                                   std::is_same<FlipCriterion, Hoppe_konig_criterion>::value);
   const std::uint64_t n = scanned.number_of_points;
   frame = scanned.frame;
   result.number_of_zero_normals = scanned.number_of_zero_normals;
@@ -139,6 +142,25 @@ std::uint64_t scan_and_radius_stages(Source& source, const Streaming_settings& s
     result.radius_estimated = true;
     progress.report(1, 1);
   }
+  const Normal_orientation::internal::Clean_positions clean =
+    Normal_orientation::internal::apply_clean_positions(criterion, std::size_t(n), [&]() {
+      std::vector<typename Kernel::Point_3> points;
+      std::vector<typename Kernel::Vector_3> normals;
+      if (scanned.small_cloud.size() < 2)
+        return std::numeric_limits<double>::quiet_NaN();
+      for (const Point_record& r : scanned.small_cloud) {
+        points.emplace_back(r.position[0], r.position[1], r.position[2]);
+        normals.emplace_back(r.normal[0], r.normal[1], r.normal[2]);
+      }
+      const unsigned int k = unsigned(std::min<std::size_t>(settings.number_of_neighbors, points.size() - 1));
+      std::vector<std::uint32_t> nb;
+      std::vector<float> d2;
+      Normal_orientation::internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(points, k, nb, d2,
+                                                                                 Progress_reporter(), 0, 1);
+      return Normal_orientation::internal::konig_disagreement<ConcurrencyTag>(points, normals, nb, k);
+    });
+  result.konig_disagreement = clean.konig_disagreement;
+  result.konig_everywhere = clean.konig_everywhere;
   result.seconds.radius = seconds_since(t);
   return n;
 }
@@ -193,7 +215,8 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
 
   // 1-2. Scan and radius.
   Sweep_frame frame;
-  const std::uint64_t n = scan_and_radius_stages<ConcurrencyTag, Kernel>(source, settings, axis, frame, result);
+  FlipCriterion phi = criterion; // the sweep's (the coarse cloud starts again from `criterion`)
+  const std::uint64_t n = scan_and_radius_stages<ConcurrencyTag, Kernel>(source, settings, axis, frame, phi, result);
   if (n == 0) {
     component_files.keep();
     return;
@@ -225,7 +248,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   Segmenter segmenter(settings.thresholds);
   Sweep_stage_result swept;
   Segmenting_visitor<ConcurrencyTag, Kernel, FlipCriterion, Unary> visitor(
-    criterion, unary, segmenter, records, edges.get(), radius, sweep_progress, n, swept);
+    phi, unary, segmenter, records, edges.get(), radius, sweep_progress, n, swept);
   Sweep_window<Sweep_payload> window;
   Sweep_options so;
   so.number_of_neighbors = k;

@@ -12,6 +12,7 @@
 #include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/Point_record.h>
 #include <Normal_orientation/Progress.h>
+#include <Normal_orientation/internal/Clean_positions.h>
 #include <Normal_orientation/internal/Parallel.h>
 #include <Normal_orientation/streaming/external_sort.h>
 
@@ -35,6 +36,9 @@ struct Scan_result
   std::uint64_t number_of_zero_normals = 0;
   Sweep_frame frame;         ///< the principal frame (not for a presorted input)
   std::vector<Point> sample; ///< a uniform sample (when the radius is to be estimated)
+  /// every record, when asked and there are at most
+  /// `clean_positions_maximum_points` (else empty)
+  std::vector<Point_record> small_cloud;
 };
 
 /// The points of the radius sample
@@ -43,11 +47,14 @@ constexpr std::size_t radius_sample_size = 200000;
 /// Reads `source` once, from its start, and rewinds it.  `axis` is the
 /// presorted coordinate (0, 1, 2), or -1 for an input in any order, whose
 /// principal frame is then computed.  A deterministic reservoir sample of
-/// at most `radius_sample_size` points is kept when `sample` is true.
+/// at most `radius_sample_size` points is kept when `sample` is true, and
+/// a copy of a cloud of at most `clean_positions_maximum_points` points when
+/// `keep_small` is true.
 /// \throw std::runtime_error for non-finite coordinates, or for a presorted
 ///        input out of order (naming the point)
 template <typename Point, typename Source>
-Scan_result<Point> scan(Source& source, int axis, bool sample, const Progress_reporter& progress)
+Scan_result<Point> scan(Source& source, int axis, bool sample, const Progress_reporter& progress,
+                        bool keep_small = false)
 {
   Scan_result<Point> result;
   Moment_accumulator moments;
@@ -83,6 +90,8 @@ Scan_result<Point> scan(Source& source, int axis, bool sample, const Progress_re
         }
       } else
         moments.add(r);
+      if (keep_small && n < Normal_orientation::internal::clean_positions_maximum_points)
+        result.small_cloud.push_back(r);
       if (sample) {
         const Point p(r.position[0], r.position[1], r.position[2]);
         if (result.sample.size() < radius_sample_size)
@@ -101,6 +110,8 @@ Scan_result<Point> scan(Source& source, int axis, bool sample, const Progress_re
   if (axis < 0)
     result.frame = moments.frame();
   result.number_of_points = n;
+  if (n > Normal_orientation::internal::clean_positions_maximum_points)
+    std::vector<Point_record>().swap(result.small_cloud);
   progress.report(n, n);
   if (non_finite > 0)
     throw std::runtime_error("streaming_orient_normals: the input has points with non-finite coordinates");
