@@ -134,30 +134,25 @@ std::uint64_t scan_and_radius_stages(Source& source, const Streaming_settings& s
   if (n == 0)
     return 0;
   t = std::chrono::steady_clock::now();
+  // A small cloud kept for the rule of clean positions is also the whole
+  // radius sample: one search serves both.
+  const Small_cloud_neighbors<Kernel> small =
+    small_cloud_neighbors<ConcurrencyTag, Kernel>(scanned.small_cloud, settings.number_of_neighbors);
   result.neighbor_radius = settings.neighbor_radius;
   if (estimate_radius) {
     const Progress_reporter progress = stage_progress(settings.progress, Stage::RADIUS);
     progress.report(0, 1);
-    result.neighbor_radius = sample_radius<ConcurrencyTag, Kernel>(scanned.sample, settings.number_of_neighbors, n);
+    result.neighbor_radius = small.k > 0 ? radius_of_neighbors(small.d2, small.k, 1.0)
+                                         : sample_radius<ConcurrencyTag, Kernel>(scanned.sample,
+                                                                                  settings.number_of_neighbors, n);
     result.radius_estimated = true;
     progress.report(1, 1);
   }
   const Normal_orientation::internal::Clean_positions clean =
     Normal_orientation::internal::apply_clean_positions(criterion, std::size_t(n), [&]() {
-      std::vector<typename Kernel::Point_3> points;
-      std::vector<typename Kernel::Vector_3> normals;
-      if (scanned.small_cloud.size() < 2)
-        return std::numeric_limits<double>::quiet_NaN();
-      for (const Point_record& r : scanned.small_cloud) {
-        points.emplace_back(r.position[0], r.position[1], r.position[2]);
-        normals.emplace_back(r.normal[0], r.normal[1], r.normal[2]);
-      }
-      const unsigned int k = unsigned(std::min<std::size_t>(settings.number_of_neighbors, points.size() - 1));
-      std::vector<std::uint32_t> nb;
-      std::vector<float> d2;
-      Normal_orientation::internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(points, k, nb, d2,
-                                                                                 Progress_reporter(), 0, 1);
-      return Normal_orientation::internal::konig_disagreement<ConcurrencyTag>(points, normals, nb, k);
+      return small.k > 0 ? Normal_orientation::internal::konig_disagreement<ConcurrencyTag>(small.points, small.normals,
+                                                                                            small.nb, small.k)
+                         : std::numeric_limits<double>::quiet_NaN();
     });
   result.konig_disagreement = clean.konig_disagreement;
   result.konig_everywhere = clean.konig_everywhere;

@@ -82,8 +82,10 @@ double konig_disagreement(const std::vector<Point>& points, const std::vector<Ve
   const Hoppe_criterion hoppe;
   const Konig_criterion konig;
   parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i)
-      for (unsigned int t = 0; t < k && measured_point(points[i], n); ++t) {
+    for (std::size_t i = b; i < e; ++i) {
+      if (!measured_point(points[i], n))
+        continue;
+      for (unsigned int t = 0; t < k; ++t) {
         const std::uint32_t j = nb[i * k + t];
         if (j >= n || j == i)
           continue;
@@ -94,6 +96,7 @@ double konig_disagreement(const std::vector<Point>& points, const std::vector<Ve
         if (h * konig(points[i], normals[i], points[j], normals[j]) < 0.0)
           ++disagree[i];
       }
+    }
   });
   std::uint64_t p = 0, d = 0;
   for (std::size_t i = 0; i < n; ++i) {

@@ -113,6 +113,14 @@ std::vector<float> edge_slopes(const Neighbor_graph& graph, const std::vector<ty
   return slope;
 }
 
+/// `median` within [`patch_slope_floor`, `sheet_slope`]: the largest edge
+/// slope of the winding number's patches, in core (`patch_slope()`) and
+/// streamed (`streaming::internal::Patch_units::patch_slope()`).
+inline double clamp_patch_slope(double median)
+{
+  return std::min(sheet_slope, std::max(patch_slope_floor, median));
+}
+
 /// The largest edge slope of the winding number's patches: the median of
 /// `slopes` (every 16th of them), within [`patch_slope_floor`,
 /// `sheet_slope`].  On a clean cloud the patches end where the surface bends
@@ -127,7 +135,7 @@ inline double patch_slope(const std::vector<float>& slopes)
   if (some.empty())
     return sheet_slope;
   std::nth_element(some.begin(), some.begin() + std::ptrdiff_t(some.size() / 2), some.end());
-  return std::min(sheet_slope, std::max(patch_slope_floor, double(some[some.size() / 2])));
+  return clamp_patch_slope(double(some[some.size() / 2]));
 }
 
 /// Whether an edge joins two points of one smooth sheet that the solver

@@ -82,7 +82,7 @@ Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std
       const double sign = double(points.labels()[q]) * (flip_component[c] ? -1.0 : 1.0);
       const std::array<double, 3> u = unit_normal(s.record);
       std::uint32_t unit = 0;
-      if (units) {
+      if (units && !units->overflowed()) { // (after an overflow, the units and their file are dropped)
         const Earlier_edge* point_edges = nullptr;
         std::size_t count = 0;
         edge_reader->next(point_edges, count);

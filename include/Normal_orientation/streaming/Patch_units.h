@@ -171,8 +171,7 @@ public:
         break;
     }
     const double median = (double(b) + 0.5) / double(m_histogram.size());
-    return std::min(Normal_orientation::internal::sheet_slope,
-                    std::max(Normal_orientation::internal::patch_slope_floor, median));
+    return Normal_orientation::internal::clamp_patch_slope(median);
   }
 
 private:

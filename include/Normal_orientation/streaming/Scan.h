@@ -43,6 +43,8 @@ struct Scan_result
 
 /// The points of the radius sample
 constexpr std::size_t radius_sample_size = 200000;
+static_assert(radius_sample_size == Normal_orientation::internal::clean_positions_maximum_points,
+              "a small cloud kept for the rule of clean positions is its own radius sample");
 
 /// Reads `source` once, from its start, and rewinds it.  `axis` is the
 /// presorted coordinate (0, 1, 2), or -1 for an input in any order, whose
@@ -118,6 +120,16 @@ Scan_result<Point> scan(Source& source, int axis, bool sample, const Progress_re
   return result;
 }
 
+/// The rule of `estimate_neighbor_radius()` over the k-th neighbour
+/// distances of the kNN distances `d2` (k per point, k > 0), times `factor`.
+inline double radius_of_neighbors(const std::vector<float>& d2, unsigned int k, double factor)
+{
+  std::vector<float> kth(d2.size() / k);
+  for (std::size_t i = 0; i < kth.size(); ++i)
+    kth[i] = d2[i * k + (k - 1)];
+  return estimate_neighbor_radius(kth, factor);
+}
+
 /// r for a cloud of `n` points of which `sample` is a uniform sample: the
 /// rule of `estimate_neighbor_radius()` over the sample's k-th neighbour
 /// distances, scaled by sqrt(sample / n) (the spacing of a surface sample).
@@ -139,10 +151,41 @@ double sample_radius(std::vector<typename Kernel::Point_3>& sample, unsigned int
   std::vector<float> d2;
   Normal_orientation::internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(sample, ks, nb, d2, Progress_reporter(),
                                                                              0, 1);
-  std::vector<float> kth(sample.size());
-  for (std::size_t i = 0; i < sample.size(); ++i)
-    kth[i] = d2[i * ks + (ks - 1)];
-  return estimate_neighbor_radius(kth, std::sqrt(double(sample.size()) / double(n)));
+  return radius_of_neighbors(d2, ks, std::sqrt(double(sample.size()) / double(n)));
+}
+
+/// A small cloud (`Scan_result::small_cloud`) in Morton order, with the kNN
+/// of each point (k lowered to the points - 1): what the rule of clean
+/// positions measures, and, the cloud being its own radius sample, what the
+/// radius is estimated from.
+template <typename Kernel>
+struct Small_cloud_neighbors
+{
+  std::vector<typename Kernel::Point_3> points;
+  std::vector<typename Kernel::Vector_3> normals;
+  std::vector<std::uint32_t> nb;
+  std::vector<float> d2;
+  unsigned int k = 0; ///< 0: fewer than 2 points, nothing searched
+};
+
+/// the kNN of `cloud` (see `Small_cloud_neighbors`)
+template <typename ConcurrencyTag, typename Kernel>
+Small_cloud_neighbors<Kernel> small_cloud_neighbors(const std::vector<Point_record>& cloud, unsigned int k)
+{
+  Small_cloud_neighbors<Kernel> out;
+  if (cloud.size() < 2)
+    return out;
+  std::vector<typename Kernel::Point_3> points;
+  for (const Point_record& r : cloud)
+    points.emplace_back(r.position[0], r.position[1], r.position[2]);
+  for (std::uint32_t i : Normal_orientation::internal::morton_order<ConcurrencyTag>(points)) {
+    out.points.push_back(points[i]);
+    out.normals.emplace_back(cloud[i].normal[0], cloud[i].normal[1], cloud[i].normal[2]);
+  }
+  out.k = unsigned(std::min<std::size_t>(k, cloud.size() - 1));
+  Normal_orientation::internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(out.points, out.k, out.nb, out.d2,
+                                                                             Progress_reporter(), 0, 1);
+  return out;
 }
 
 /// A source that reports, after every read, the number of records read so
