@@ -1041,7 +1041,13 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
   // Noisy open scans (noise 0.2% of the diagonal, PCA normals): small
   // pieces are seen from behind about as much as from the front, so
   // visibility decides per sheet, streamed as in core, not per segment.
-  for (const char* name : {"street_canyon", "city_block"}) {
+  // The lower half of the single-view scan faces down, and the views from
+  // above see it from behind through the open back: the segments' tier of
+  // streamed visibility must not turn it (`segment_tier_flips()`; 1.29%
+  // streamed when only the views from above counted there).
+  const std::pair<const char*, double> noisy_scans[] = {
+    {"street_canyon", 0.02}, {"city_block", 0.02}, {"single_view_scan", 0.005}};
+  for (const auto& [name, bound] : noisy_scans) {
     std::mt19937_64 g(41);
     const auto truth = NO::hard_shapes::hard_shape(name, 20000, g);
     auto input = unoriented(truth, g);
@@ -1058,8 +1064,8 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
     const double n = double(truth.size());
     std::printf("%s, noise 0.2%%: wrong streamed %6.2f%%, in core %6.2f%%\n", name, 100.0 * double(o.streamed) / n,
                 100.0 * double(o.core) / n);
-    EXPECT_LE(double(o.streamed) / n, 0.02) << name;
-    EXPECT_LE(double(o.core) / n, 0.02) << name;
+    EXPECT_LE(double(o.streamed) / n, bound) << name;
+    EXPECT_LE(double(o.core) / n, bound) << name;
   }
   // an explicit none runs no stage
   std::mt19937_64 rng(2);

@@ -9,6 +9,7 @@
 /// the signs of patches (unions of `Patch_units`, as the in-core patches are
 /// unions of points), and every point follows its unit.
 
+#include <Normal_orientation/Exterior_visibility.h>
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Winding_number_field.h>
@@ -234,10 +235,47 @@ struct Stream_seen_sides
   std::vector<std::uint32_t> unit_sheet;             ///< per unit
 };
 
+/// The segments' tier of streamed visibility: the final segments (groups
+/// of `segment_patch`, per sample) that, after the components' and sheets'
+/// decisions of `seen`, still face away from where they were seen, both by
+/// the votes of `seen` (views below the horizon weigh less) and by views
+/// that all weigh 1.  The streamed labelling is the segment solver's, whose
+/// errors are whole segments; but the lower part of an object scanned from
+/// one side faces down, and the views from above see it from behind,
+/// through the open back: only they would turn it.
+template <typename ConcurrencyTag, typename Kernel>
+std::vector<char> segment_tier_flips(const Global_samples<Kernel>& samples, const std::vector<double>& areas,
+                                     const Normal_orientation::internal::Seen_side_flips& seen,
+                                     const std::vector<std::uint32_t>& sheet,
+                                     const std::vector<std::uint32_t>& segment_patch, std::size_t number_of_segments,
+                                     const std::vector<char>& component_fixed,
+                                     const Normal_orientation::internal::Global_settings& settings)
+{
+  const std::size_t ns = samples.points.size();
+  Exterior_visibility_options even = settings.visibility();
+  even.up = {{0.0, 0.0, 0.0}}; // (every view weighs 1)
+  std::vector<double> vote = seen.vote,
+                      even_vote = exterior_visibility<ConcurrencyTag>(samples.points, samples.normals, areas, even);
+  std::vector<char> free_segment(number_of_segments, 0);
+  for (std::size_t j = 0; j < ns; ++j) {
+    free_segment[segment_patch[j]] = !component_fixed[samples.component[j]];
+    if (seen.component[samples.component[j]] != seen.patch[sheet[j]]) {
+      vote[j] = -vote[j];
+      even_vote[j] = -even_vote[j];
+    }
+  }
+  std::vector<char> flip = visibility_flips(vote, areas, segment_patch, free_segment);
+  const std::vector<char> even_flip = visibility_flips(even_vote, areas, segment_patch, free_segment);
+  for (std::size_t P = 0; P < flip.size(); ++P)
+    flip[P] = char(flip[P] && even_flip[P]);
+  return flip;
+}
+
 /// Exterior visibility over the samples: components, then sheets (with
 /// `units`, the unit patches of slope at most `sheet_slope`, as in core;
 /// else the final segments), then, with units, the final segments that
-/// still face away from where they were seen.
+/// still face away from where they were seen both with the views weighted
+/// by the up direction and with every view weighing 1 (`segment_tier_flips()`).
 template <typename ConcurrencyTag, typename Kernel>
 Stream_seen_sides stream_seen_sides(const Global_samples<Kernel>& samples, const std::vector<double>& areas,
                                     const std::vector<std::uint32_t>& segment_patch, std::size_t number_of_segments,
@@ -263,14 +301,8 @@ Stream_seen_sides stream_seen_sides(const Global_samples<Kernel>& samples, const
     out.number_of_sheets, component_fixed, settings);
   std::vector<char> segment_flip(number_of_segments, 0);
   if (units && settings.orientation == Normal_orientation::Global_orientation::VISIBILITY_AND_WINDING) {
-    std::vector<double> vote = out.seen.vote;
-    std::vector<char> free_segment(number_of_segments, 0);
-    for (std::size_t j = 0; j < ns; ++j) {
-      free_segment[segment_patch[j]] = !component_fixed[samples.component[j]];
-      if (out.seen.component[samples.component[j]] != out.seen.patch[out.sheet[j]])
-        vote[j] = -vote[j];
-    }
-    segment_flip = visibility_flips(vote, areas, segment_patch, free_segment);
+    segment_flip = segment_tier_flips<ConcurrencyTag>(samples, areas, out.seen, out.sheet, segment_patch,
+                                                      number_of_segments, component_fixed, settings);
     for (char f : segment_flip)
       out.seen.patches_flipped += f ? 1 : 0;
   }
