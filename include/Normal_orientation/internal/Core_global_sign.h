@@ -14,6 +14,7 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Signed_union_find.h>
 #include <Normal_orientation/Winding_number_field.h>
+#include <Normal_orientation/internal/Graph_reduction.h>
 #include <Normal_orientation/internal/Parallel.h>
 
 #include <algorithm>
@@ -368,6 +369,59 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
   return out;
 }
 
+/// The segments' tier of exterior visibility, after the components and the
+/// sheets of `seen`: the segments (`sample_segment`, per sample, below
+/// `number_of_segments`) that still face away from where they were seen,
+/// both by the votes of `seen` (views below the horizon weigh less) and by
+/// views that all weigh 1 (`normals`: the orientation that `seen` voted
+/// on).  The solvers' errors are whole segments; but the lower part of an
+/// object scanned from one side faces down, and the views from above see it
+/// from behind, through the open back: only they would turn it.  Nothing
+/// unless `settings` asks for visibility.
+template <typename ConcurrencyTag, typename Point, typename Vector>
+std::vector<char> segment_tier_flips(const std::vector<Point>& points, const std::vector<Vector>& normals,
+                                     const std::vector<double>& areas,
+                                     const std::vector<std::uint32_t>& sample_component,
+                                     const std::vector<std::uint32_t>& sample_sheet,
+                                     const std::vector<std::uint32_t>& sample_segment, std::size_t number_of_segments,
+                                     const Seen_side_flips& seen, const std::vector<char>& component_fixed,
+                                     const Global_settings& settings)
+{
+  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
+    return std::vector<char>(number_of_segments, 0);
+  Exterior_visibility_options even = settings.visibility();
+  even.up = {{0.0, 0.0, 0.0}}; // (every view weighs 1)
+  std::vector<double> vote = seen.vote, even_vote = exterior_visibility<ConcurrencyTag>(points, normals, areas, even);
+  std::vector<char> free_segment(number_of_segments, 0);
+  for (std::size_t j = 0; j < points.size(); ++j) {
+    free_segment[sample_segment[j]] = !component_fixed[sample_component[j]];
+    if (seen.component[sample_component[j]] != seen.patch[sample_sheet[j]]) {
+      vote[j] = -vote[j];
+      even_vote[j] = -even_vote[j];
+    }
+  }
+  std::vector<char> flip = visibility_flips(vote, areas, sample_segment, free_segment);
+  const std::vector<char> even_flip = visibility_flips(even_vote, areas, sample_segment, free_segment);
+  for (std::size_t P = 0; P < flip.size(); ++P)
+    flip[P] = char(flip[P] && even_flip[P]);
+  return flip;
+}
+
+/// The segments of the labelling `labels` on `graph` (`reduce_to_segments()`:
+/// the paper's segmentation with its default thresholds, in vertex order, in
+/// the frame where `labels` is all +1): regions that the labelling made
+/// consistent, as the streamed driver's final segments are.  Writes the
+/// segment of every vertex to `segment`; returns their number.
+inline std::size_t labelling_segments(const Neighbor_graph& graph, const std::vector<Label>& labels,
+                                      std::vector<std::uint32_t>& segment)
+{
+  Segment_reduction r =
+    reduce_to_segments(Incidence(graph, get(&Neighbor_edge::weight, graph), "the global stage"),
+                       std::vector<double>(), labels);
+  segment = std::move(r.segment);
+  return r.reduced.number_of_vertices;
+}
+
 /// The components (ids below `number_of_components`, those of `fixed` left
 /// out) whose top surface faces down (`downward_top_flips()` of
 /// `top_view_facing()` of the samples, with their final oriented normals);
@@ -546,14 +600,29 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   std::vector<std::uint32_t> sample_sheet(ns);
   for (std::size_t t = 0; t < ns; ++t)
     sample_sheet[t] = sheet[samples.index[t]];
-  const Seen_side_flips seen = seen_side_flips<ConcurrencyTag>(
-    samples.points, samples.oriented, samples.areas, samples.component, sample_sheet, nc, number_of_sheets,
-    component_fixed, settings);
+  Seen_side_flips seen = seen_side_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
+                                                         samples.component, sample_sheet, nc, number_of_sheets,
+                                                         component_fixed, settings);
+  std::vector<std::uint32_t> segment, sample_segment(ns);
+  std::vector<char> segment_flip;
+  if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING) {
+    const std::size_t number_of_segments = labelling_segments(graph, labels, segment);
+    for (std::size_t t = 0; t < ns; ++t)
+      sample_segment[t] = segment[samples.index[t]];
+    segment_flip = segment_tier_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
+                                                      samples.component, sample_sheet, sample_segment,
+                                                      number_of_segments, seen, component_fixed, settings);
+    for (char f : segment_flip)
+      seen.patches_flipped += f ? 1 : 0;
+  }
+  auto seen_flip = [&](std::uint32_t c, std::uint32_t sheet_id, std::uint32_t segment_id) {
+    return (seen.component[c] != seen.patch[sheet_id]) != (!segment_flip.empty() && segment_flip[segment_id]);
+  };
   for (std::size_t i = 0; i < n; ++i)
-    if (seen.component[component[i]] != seen.patch[sheet[i]])
+    if (seen_flip(component[i], sheet[i], segment.empty() ? 0 : segment[i]))
       labels[i] = Label(-labels[i]);
   for (std::size_t t = 0; t < ns; ++t)
-    if (seen.component[samples.component[t]] != seen.patch[sample_sheet[t]])
+    if (seen_flip(samples.component[t], sample_sheet[t], sample_segment[t]))
       samples.oriented[t] = -samples.oriented[t];
   const std::vector<Label> seen_labels = labels;
   // 2. The winding number.

@@ -9,7 +9,6 @@
 /// the signs of patches (unions of `Patch_units`, as the in-core patches are
 /// unions of points), and every point follows its unit.
 
-#include <Normal_orientation/Exterior_visibility.h>
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Winding_number_field.h>
@@ -235,42 +234,6 @@ struct Stream_seen_sides
   std::vector<std::uint32_t> unit_sheet;             ///< per unit
 };
 
-/// The segments' tier of streamed visibility: the final segments (groups
-/// of `segment_patch`, per sample) that, after the components' and sheets'
-/// decisions of `seen`, still face away from where they were seen, both by
-/// the votes of `seen` (views below the horizon weigh less) and by views
-/// that all weigh 1.  The streamed labelling is the segment solver's, whose
-/// errors are whole segments; but the lower part of an object scanned from
-/// one side faces down, and the views from above see it from behind,
-/// through the open back: only they would turn it.
-template <typename ConcurrencyTag, typename Kernel>
-std::vector<char> segment_tier_flips(const Global_samples<Kernel>& samples, const std::vector<double>& areas,
-                                     const Normal_orientation::internal::Seen_side_flips& seen,
-                                     const std::vector<std::uint32_t>& sheet,
-                                     const std::vector<std::uint32_t>& segment_patch, std::size_t number_of_segments,
-                                     const std::vector<char>& component_fixed,
-                                     const Normal_orientation::internal::Global_settings& settings)
-{
-  const std::size_t ns = samples.points.size();
-  Exterior_visibility_options even = settings.visibility();
-  even.up = {{0.0, 0.0, 0.0}}; // (every view weighs 1)
-  std::vector<double> vote = seen.vote,
-                      even_vote = exterior_visibility<ConcurrencyTag>(samples.points, samples.normals, areas, even);
-  std::vector<char> free_segment(number_of_segments, 0);
-  for (std::size_t j = 0; j < ns; ++j) {
-    free_segment[segment_patch[j]] = !component_fixed[samples.component[j]];
-    if (seen.component[samples.component[j]] != seen.patch[sheet[j]]) {
-      vote[j] = -vote[j];
-      even_vote[j] = -even_vote[j];
-    }
-  }
-  std::vector<char> flip = visibility_flips(vote, areas, segment_patch, free_segment);
-  const std::vector<char> even_flip = visibility_flips(even_vote, areas, segment_patch, free_segment);
-  for (std::size_t P = 0; P < flip.size(); ++P)
-    flip[P] = char(flip[P] && even_flip[P]);
-  return flip;
-}
-
 /// Exterior visibility over the samples: components, then sheets (with
 /// `units`, the unit patches of slope at most `sheet_slope`, as in core;
 /// else the final segments), then, with units, the final segments that
@@ -301,8 +264,9 @@ Stream_seen_sides stream_seen_sides(const Global_samples<Kernel>& samples, const
     out.number_of_sheets, component_fixed, settings);
   std::vector<char> segment_flip(number_of_segments, 0);
   if (units && settings.orientation == Normal_orientation::Global_orientation::VISIBILITY_AND_WINDING) {
-    segment_flip = segment_tier_flips<ConcurrencyTag>(samples, areas, out.seen, out.sheet, segment_patch,
-                                                      number_of_segments, component_fixed, settings);
+    segment_flip = Normal_orientation::internal::segment_tier_flips<ConcurrencyTag>(
+      samples.points, samples.normals, areas, samples.component, out.sheet, segment_patch, number_of_segments,
+      out.seen, component_fixed, settings);
     for (char f : segment_flip)
       out.seen.patches_flipped += f ? 1 : 0;
   }
