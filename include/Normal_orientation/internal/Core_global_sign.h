@@ -376,8 +376,10 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
 /// views that all weigh 1 (`normals`: the orientation that `seen` voted
 /// on).  The solvers' errors are whole segments; but the lower part of an
 /// object scanned from one side faces down, and the views from above see it
-/// from behind, through the open back: only they would turn it.  Nothing
-/// unless `settings` asks for visibility.
+/// from behind, through the open back: only they would turn it.  (The
+/// views of weight 1 are drawn only where the first votes turn a segment
+/// and there is an up direction.)  Nothing unless `settings` asks for
+/// visibility.
 template <typename ConcurrencyTag, typename Point, typename Vector>
 std::vector<char> segment_tier_flips(const std::vector<Point>& points, const std::vector<Vector>& normals,
                                      const std::vector<double>& areas,
@@ -389,19 +391,24 @@ std::vector<char> segment_tier_flips(const std::vector<Point>& points, const std
 {
   if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
     return std::vector<char>(number_of_segments, 0);
-  Exterior_visibility_options even = settings.visibility();
-  even.up = {{0.0, 0.0, 0.0}}; // (every view weighs 1)
-  std::vector<double> vote = seen.vote, even_vote = exterior_visibility<ConcurrencyTag>(points, normals, areas, even);
+  // (the votes as they stand after the components and sheets of `seen`)
+  auto after_seen = [&](std::vector<double> v) {
+    for (std::size_t j = 0; j < points.size(); ++j)
+      if (seen.component[sample_component[j]] != seen.patch[sample_sheet[j]])
+        v[j] = -v[j];
+    return v;
+  };
   std::vector<char> free_segment(number_of_segments, 0);
-  for (std::size_t j = 0; j < points.size(); ++j) {
+  for (std::size_t j = 0; j < points.size(); ++j)
     free_segment[sample_segment[j]] = !component_fixed[sample_component[j]];
-    if (seen.component[sample_component[j]] != seen.patch[sample_sheet[j]]) {
-      vote[j] = -vote[j];
-      even_vote[j] = -even_vote[j];
-    }
-  }
-  std::vector<char> flip = visibility_flips(vote, areas, sample_segment, free_segment);
-  const std::vector<char> even_flip = visibility_flips(even_vote, areas, sample_segment, free_segment);
+  std::vector<char> flip = visibility_flips(after_seen(seen.vote), areas, sample_segment, free_segment);
+  const Exterior_visibility_options weighted = settings.visibility();
+  if (std::find(flip.begin(), flip.end(), 1) == flip.end() || weighted.up == std::array<double, 3>{{0.0, 0.0, 0.0}})
+    return flip; // (nothing to confirm, or every view already weighs 1)
+  Exterior_visibility_options even = weighted;
+  even.up = {{0.0, 0.0, 0.0}}; // (every view weighs 1)
+  const std::vector<char> even_flip = visibility_flips(
+    after_seen(exterior_visibility<ConcurrencyTag>(points, normals, areas, even)), areas, sample_segment, free_segment);
   for (std::size_t P = 0; P < flip.size(); ++P)
     flip[P] = char(flip[P] && even_flip[P]);
   return flip;
