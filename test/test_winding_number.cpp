@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstring>
 #include <iostream>
+#include <limits>
 #include <random>
 #include <vector>
 
@@ -322,6 +323,89 @@ TEST(Winding_number_field, GradientMatchesFiniteDifferences)
       EXPECT_NEAR(g[k], fd, 1e-4 * std::max(1.0, std::abs(fd)));
     }
   }
+}
+
+// Two unit spheres that nearly touch, and a shell whose two walls are as close:
+// the far field in the gap is near 1 across the contact and near 0 inside the
+// wall, whereas the field itself reads about 0.6 and 0.35 there.
+TEST(Winding_number_field, FarFieldTellsAContactFromAWall)
+{
+  const double gap = 0.02, exclusion = 0.3;
+  const std::size_t n = 20000;
+  std::mt19937_64 rng(13);
+  Cloud contact, wall;
+  const double offsets[2] = {-(1.0 + 0.5 * gap), 1.0 + 0.5 * gap};
+  for (double x : offsets)
+    for (const NO::test::Sample& s : NO::test::sphere(n, rng, Point(x, 0, 0))) {
+      contact.points.push_back(s.p);
+      contact.normals.push_back(s.n);
+      contact.areas.push_back(4.0 * M_PI / double(n));
+    }
+  const double radii[2] = {1.0, 1.0 + gap}; // the inner wall faces the cavity
+  for (double r : radii)
+    for (const NO::test::Sample& s : NO::test::sphere(n, rng, Point(0, 0, 0), r)) {
+      wall.points.push_back(s.p);
+      wall.normals.push_back(r < 1.0 + 0.5 * gap ? -s.n : s.n);
+      wall.areas.push_back(4.0 * M_PI * r * r / double(n));
+    }
+  const Point contact_gap(0, 0, 0), wall_gap(1.0 + 0.5 * gap, 0, 0);
+  Field fc, fw;
+  fc.build(contact.points, contact.normals, contact.areas);
+  fw.build(wall.points, wall.normals, wall.areas);
+  const double wc = fc.far_value(contact_gap, exclusion), ww = fw.far_value(wall_gap, exclusion);
+  std::cout << "far field in the gap: contact " << wc << " (w " << fc.value(contact_gap) << "), wall " << ww
+            << " (w " << fw.value(wall_gap) << ")\n";
+  // Across the contact each sphere gives the solid angle of its left-out cap
+  // over 4 pi: (1 - cos a) / 2, where cos a = 0.0545 / 0.3 at the rim of the
+  // cap (0.3 from the gap's middle), so 0.818 for the two.
+  EXPECT_NEAR(wc, 0.818, 0.03);
+  EXPECT_LT(ww, 0.15);
+  EXPECT_NEAR(wc, fc.direct_far_value(contact_gap, exclusion), 0.015);
+  EXPECT_NEAR(ww, fw.direct_far_value(wall_gap, exclusion), 0.015);
+  // the signs of the points within the exclusion radius do not matter
+  std::vector<std::size_t> near;
+  for (std::size_t i = 0; i < wall.points.size(); ++i)
+    if (std::sqrt((wall.points[i] - wall_gap).squared_length()) < exclusion)
+      near.push_back(i);
+  ASSERT_GT(near.size(), 100u);
+  const double before = fw.value(wall_gap);
+  fw.negate(near);
+  EXPECT_EQ(fw.far_value(wall_gap, exclusion), ww);
+  EXPECT_GT(std::abs(fw.value(wall_gap) - before), 0.3); // while the field itself changed
+}
+
+TEST(Winding_number_field, FarFieldMatchesTheDirectSum)
+{
+  const Cloud c = sphere_cloud(20000, 17);
+  Field field;
+  field.build(c.points, c.normals, c.areas);
+  const std::vector<Point> q = make_queries(c, 600, 19);
+  const double radii[5] = {0.0, 0.05, 0.3, 1.0, 10.0};
+  std::vector<double> exclusions(q.size());
+  for (std::size_t t = 0; t < q.size(); ++t)
+    exclusions[t] = radii[t % 5];
+  std::vector<double> values, sequential;
+  field.evaluate_far(q, exclusions, values);
+  field.evaluate_far<CGAL::Sequential_tag>(q, exclusions, sequential);
+  EXPECT_TRUE(same_bits(values, sequential));
+  double error = 0.0;
+  for (std::size_t t = 0; t < q.size(); ++t) {
+    EXPECT_EQ(values[t], field.far_value(q[t], exclusions[t]));
+    error = std::max(error, std::abs(values[t] - field.direct_far_value(q[t], exclusions[t])));
+    if (exclusions[t] == 0.0) { // nothing left out: the field itself
+      EXPECT_NEAR(values[t], field.value(q[t]), 1e-12);
+    }
+    if (exclusions[t] == 10.0) { // everything left out
+      EXPECT_EQ(values[t], 0.0);
+    }
+  }
+  std::cout << "far field: max |error| against the direct sum " << error << "\n";
+  EXPECT_LT(error, 0.015); // the bound of the full field at the default opening ratio
+  EXPECT_THROW(field.far_value(q[0], -1.0), std::invalid_argument);
+  EXPECT_THROW(field.direct_far_value(q[0], std::nan("")), std::invalid_argument);
+  EXPECT_THROW(field.evaluate_far(q, std::vector<double>(3, 0.0), values), std::invalid_argument);
+  exclusions[5] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(field.evaluate_far(q, exclusions, values), std::invalid_argument);
 }
 
 TEST(Winding_number_field, SmallAndBadInputs)

@@ -437,6 +437,46 @@ public:
     run<ConcurrencyTag, true, true>(queries, values, &gradients);
   }
 
+  /// The far field of q: w(q) summed over the points at distance at least
+  /// `exclusion` from q only, by the treecode.  Whatever the signs of the
+  /// points nearer than that, it is the same; across a thin gap between two
+  /// layers of a closed surface it is near 1 when the gap is outside (a
+  /// contact) and near 0 when it is inside (a wall), once the left-out
+  /// layers are wide against the gap (see the manual).  With `exclusion` = 0
+  /// it is `value(q)`, up to the treecode's error.
+  /// \throw std::invalid_argument when `exclusion` is not finite and >= 0
+  double far_value(const Point_3& q, double exclusion) const
+  {
+    return far<false>(q, exclusion);
+  }
+  /// `far_value()` by the direct sum (O(n))
+  double direct_far_value(const Point_3& q, double exclusion) const
+  {
+    return far<true>(q, exclusion);
+  }
+  /// Evaluates the far field at every query by the treecode, in parallel:
+  /// `values[t]` = `far_value(queries[t], exclusions[t])`, the same bit for
+  /// bit for any number of threads.
+  /// \tparam ConcurrencyTag `CGAL::Parallel_tag` or `CGAL::Sequential_tag`
+  /// \tparam PointRange a random-access range of `Point_3`
+  /// \throw std::invalid_argument when `exclusions` is not one finite value
+  ///        >= 0 per query
+  template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag, typename PointRange>
+  void evaluate_far(const PointRange& queries, const std::vector<double>& exclusions,
+                    std::vector<double>& values) const
+  {
+    const std::size_t m = std::size_t(queries.size());
+    if (exclusions.size() != m)
+      throw std::invalid_argument("Winding_number_field::evaluate_far: one exclusion radius per query");
+    for (double x : exclusions)
+      check_exclusion(x);
+    values.assign(m, 0.0);
+    internal::parallel_chunks<ConcurrencyTag>(m, [&](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t)
+        values[t] = far<false>(queries[t], exclusions[t]);
+    }, 64);
+  }
+
   /// The moment a_i s_i n_i of point i (area times signed unit normal).
   Vector_3 moment(std::size_t i) const
   {
@@ -537,6 +577,21 @@ private:
           (*gradients)[t] = Vector_3(g[0] * s, g[1] * s, g[2] * s);
       }
     }, Direct ? 4 : 64);
+  }
+
+  static void check_exclusion(double x)
+  {
+    if (!(x >= 0.0) || !std::isfinite(x))
+      throw std::invalid_argument("Winding_number_field: the exclusion radius must be finite and >= 0");
+  }
+
+  template <bool Direct>
+  double far(const Point_3& q, double exclusion) const
+  {
+    check_exclusion(exclusion);
+    double qd[3];
+    to_array(q, qd);
+    return tree_.template evaluate_far<Direct>(qd, beta_ * beta_, factor_ * factor_, exclusion) * inv_4pi();
   }
 
   internal::Winding_tree tree_;

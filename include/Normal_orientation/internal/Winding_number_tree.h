@@ -233,6 +233,36 @@ public:
     add_samples<Gradient>(q, f2, 0, samples_.size(), w, g);
   }
 
+  /// w(q) over the samples at distance at least `exclusion` from q only,
+  /// without the factor 1/(4 pi): by the treecode (nodes wholly outside
+  /// that sphere are expanded when they pass the opening test, nodes wholly
+  /// inside are skipped, the others are opened), or by the direct sum.
+  template <bool Direct>
+  double evaluate_far(const double q[3], double beta2, double f2, double exclusion) const
+  {
+    double w = 0.0;
+    const double x2 = exclusion * exclusion;
+    const auto leaf = [&](std::size_t b, std::size_t e) {
+      for (std::size_t t = b; t < e; ++t) {
+        const Winding_sample& s = samples_[t];
+        const double r[3] = {s.p[0] - q[0], s.p[1] - q[1], s.p[2] - q[2]};
+        if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] >= x2)
+          Winding_kernel::add_sample<false>(r, s.an, f2 * s.area, w, nullptr);
+      }
+    };
+    if (Direct) {
+      leaf(0, samples_.size());
+      return w;
+    }
+    traverse(
+      q, beta2,
+      [&](std::size_t i, const double R[3], double) {
+        Winding_kernel::add_node<false>(nodes_[i], R, f2 * nodes_[i].mean_area, w, nullptr);
+      },
+      leaf, exclusion);
+    return w;
+  }
+
   /// Sets the charges q_t of the samples, given by input index, for
   /// `charge_field()`: every node keeps their sum and their first moment
   /// sum q_t (p_t - c) about its centre.
@@ -305,9 +335,11 @@ private:
   /// The Barnes-Hut walk from the root, nearer child first: a node whose
   /// centre is farther from q than beta times its radius goes to
   /// `far(i, R, |R|^2)` with R = c - q; a leaf that is not goes to
-  /// `leaf(b, e)`, its samples [b, e) in tree order.
+  /// `leaf(b, e)`, its samples [b, e) in tree order.  With an `exclusion`
+  /// radius > 0, a node wholly inside that sphere about q is skipped, and
+  /// one that straddles it is opened.
   template <typename Far, typename Leaf>
-  void traverse(const double q[3], double beta2, const Far& far, const Leaf& leaf) const
+  void traverse(const double q[3], double beta2, const Far& far, const Leaf& leaf, double exclusion = 0.0) const
   {
     if (nodes_.empty())
       return;
@@ -320,7 +352,14 @@ private:
       const Winding_node& node = nodes_[i];
       const double R[3] = {node.center[0] - q[0], node.center[1] - q[1], node.center[2] - q[2]};
       const double dist2 = R[0] * R[0] + R[1] * R[1] + R[2] * R[2];
-      if (dist2 > beta2 * node.radius * node.radius) {
+      bool straddles = false;
+      if (exclusion > 0.0) {
+        const double dist = std::sqrt(dist2);
+        if (dist + node.radius < exclusion)
+          continue;
+        straddles = dist - node.radius < exclusion;
+      }
+      if (!straddles && dist2 > beta2 * node.radius * node.radius) {
         far(i, R, dist2);
       } else if (i >= first_leaf) {
         const std::size_t j = i - first_leaf;
