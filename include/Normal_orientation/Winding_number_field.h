@@ -447,11 +447,13 @@ public:
   /// \throw std::invalid_argument when `exclusion` is not finite and >= 0
   double far_value(const Point_3& q, double exclusion) const
   {
+    check_exclusion(exclusion);
     return far<false>(q, exclusion);
   }
   /// `far_value()` by the direct sum (O(n))
   double direct_far_value(const Point_3& q, double exclusion) const
   {
+    check_exclusion(exclusion);
     return far<true>(q, exclusion);
   }
   /// Evaluates the far field at every query by the treecode, in parallel:
@@ -465,16 +467,11 @@ public:
   void evaluate_far(const PointRange& queries, const std::vector<double>& exclusions,
                     std::vector<double>& values) const
   {
-    const std::size_t m = std::size_t(queries.size());
-    if (exclusions.size() != m)
+    if (exclusions.size() != std::size_t(queries.size()))
       throw std::invalid_argument("Winding_number_field::evaluate_far: one exclusion radius per query");
     for (double x : exclusions)
       check_exclusion(x);
-    values.assign(m, 0.0);
-    internal::parallel_chunks<ConcurrencyTag>(m, [&](std::size_t b, std::size_t e) {
-      for (std::size_t t = b; t < e; ++t)
-        values[t] = far<false>(queries[t], exclusions[t]);
-    }, 64);
+    run<ConcurrencyTag, false, false>(queries, values, nullptr, &exclusions);
   }
 
   /// The moment a_i s_i n_i of point i (area times signed unit normal).
@@ -548,8 +545,11 @@ private:
     return tree_.samples()[tree_.position(i)];
   }
 
+  /// the values (and gradients) at the queries; with `exclusions`, the far
+  /// fields (no gradient)
   template <typename ConcurrencyTag, bool Gradient, bool Direct, typename PointRange>
-  void run(const PointRange& queries, std::vector<double>& values, std::vector<Vector_3>* gradients) const
+  void run(const PointRange& queries, std::vector<double>& values, std::vector<Vector_3>* gradients,
+           const std::vector<double>* exclusions = nullptr) const
   {
     const std::size_t m = std::size_t(queries.size());
     if (m >= std::size_t(std::numeric_limits<std::uint32_t>::max()))
@@ -567,8 +567,10 @@ private:
       for (std::size_t o = b; o < e; ++o) {
         const std::size_t t = order[o];
         const double* qd = q[t].data();
-        double w, g[3];
-        if (Direct)
+        double w, g[3] = {0.0, 0.0, 0.0};
+        if (exclusions)
+          w = tree_.template evaluate_far<Direct>(qd, beta2, f2, (*exclusions)[t]);
+        else if (Direct)
           tree_.template evaluate_direct<Gradient>(qd, f2, w, g);
         else
           tree_.template evaluate<Gradient>(qd, beta2, f2, w, g);
@@ -588,7 +590,6 @@ private:
   template <bool Direct>
   double far(const Point_3& q, double exclusion) const
   {
-    check_exclusion(exclusion);
     double qd[3];
     to_array(q, qd);
     return tree_.template evaluate_far<Direct>(qd, beta_ * beta_, factor_ * factor_, exclusion) * inv_4pi();

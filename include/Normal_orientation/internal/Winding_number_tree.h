@@ -242,16 +242,8 @@ public:
   {
     double w = 0.0;
     const double x2 = exclusion * exclusion;
-    const auto leaf = [&](std::size_t b, std::size_t e) {
-      for (std::size_t t = b; t < e; ++t) {
-        const Winding_sample& s = samples_[t];
-        const double r[3] = {s.p[0] - q[0], s.p[1] - q[1], s.p[2] - q[2]};
-        if (r[0] * r[0] + r[1] * r[1] + r[2] * r[2] >= x2)
-          Winding_kernel::add_sample<false>(r, s.an, f2 * s.area, w, nullptr);
-      }
-    };
     if (Direct) {
-      leaf(0, samples_.size());
+      add_samples<false>(q, f2, 0, samples_.size(), w, nullptr, x2);
       return w;
     }
     traverse(
@@ -259,7 +251,7 @@ public:
       [&](std::size_t i, const double R[3], double) {
         Winding_kernel::add_node<false>(nodes_[i], R, f2 * nodes_[i].mean_area, w, nullptr);
       },
-      leaf, exclusion);
+      [&](std::size_t b, std::size_t e) { add_samples<false>(q, f2, b, e, w, nullptr, x2); }, exclusion);
     return w;
   }
 
@@ -389,11 +381,15 @@ private:
   }
 
   template <bool Gradient>
-  void add_samples(const double q[3], double f2, std::size_t b, std::size_t e, double& w, double* g) const
+  /// adds the samples [b, e) but those nearer to q than sqrt(x2)
+  void add_samples(const double q[3], double f2, std::size_t b, std::size_t e, double& w, double* g,
+                   double x2 = 0.0) const
   {
     for (std::size_t t = b; t < e; ++t) {
       const Winding_sample& s = samples_[t];
       const double r[3] = {s.p[0] - q[0], s.p[1] - q[1], s.p[2] - q[2]};
+      if (x2 > 0.0 && r[0] * r[0] + r[1] * r[1] + r[2] * r[2] < x2)
+        continue;
       Winding_kernel::add_sample<Gradient>(r, s.an, f2 * s.area, w, g);
     }
   }
