@@ -68,6 +68,10 @@ inline void print_global(const Normal_orientation::Global_sign_summary& g)
                  plural(g.seen_components_flipped), g.seen_patches_flipped, plural(g.seen_patches_flipped),
                  g.seen_vetoes, g.seen_vetoes == 1 ? "" : "es", g.top_components_flipped,
                  plural(g.top_components_flipped), g.seconds);
+  if (g.ran && g.layer_pairs > 0)
+    std::fprintf(stderr, "layer cues: %zu point%s on two layers, %zu sure cue%s, %zu against the stage%s\n",
+                 g.layer_pairs, plural(g.layer_pairs), g.layer_cues, plural(g.layer_cues), g.layer_cues_against,
+                 g.layer_cue_round ? "; solved again with them" : "");
 }
 
 /// "global": what the global sign stage saw and did (null when it did not run)
@@ -87,6 +91,8 @@ inline void json_global(Json_writer& j, const Normal_orientation::Global_sign_su
   j.key("seen_components_flipped").integer(g.seen_components_flipped);
   j.key("seen_patches_flipped").integer(g.seen_patches_flipped).key("seen_vetoes").integer(g.seen_vetoes);
   j.key("top_components_flipped").integer(g.top_components_flipped);
+  j.key("layer_pairs").integer(g.layer_pairs).key("layer_cues").integer(g.layer_cues);
+  j.key("layer_cues_against").integer(g.layer_cues_against).key("layer_cue_round").boolean(g.layer_cue_round);
   j.key("energy_before").number(g.energy_before).key("energy_after").number(g.energy_after);
   j.key("coherence").number(g.coherence).key("coarse_points").integer(g.coarse_points);
   j.key("coarse_used").boolean(g.coarse_used);

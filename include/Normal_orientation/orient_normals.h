@@ -14,6 +14,7 @@
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/internal/Core_coarse_scale.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
+#include <Normal_orientation/internal/Core_layer_cues.h>
 #include <Normal_orientation/internal/Settings.h>
 #include <Normal_orientation/internal/Unit_vector.h>
 #include <Normal_orientation/parameters.h>
@@ -34,6 +35,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <iterator>
 #include <sstream>
 #include <stdexcept>
@@ -208,19 +210,29 @@ std::vector<std::uint32_t> sort_spatially(Core_points<Kernel>& in)
   return order;
 }
 
+/// Whether `Solver` takes unary terms on the in-core graph.
+template <typename Solver, typename WeightMap, typename LabelMap>
+struct Accepts_core_unary
+{
+  /// the unary map of `solve_core()`
+  typedef decltype(boost::make_iterator_property_map(
+    std::declval<std::vector<std::pair<double, double>>&>().begin(),
+    get(boost::vertex_index, std::declval<const Neighbor_graph&>()))) Unary_map;
+  static constexpr bool value = Accepts_unary<Solver, Neighbor_graph, WeightMap, Unary_map, LabelMap>::value;
+};
+
 /// Runs `solver` on `graph`, with the constraints and priors of `in` as
 /// unary terms when there are any (a constraint outweighs all the edges
-/// together); `has_unary` marks the vertices with a unary term.
+/// together), and the layer cues `cue` (per point, or empty) added to the
+/// priors; `has_unary` marks the vertices with a unary term.
 template <bool WithUnary, typename Solver, typename Kernel, typename WeightMap, typename LabelMap>
 Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, WeightMap weight, LabelMap label_map,
-                         const Core_points<Kernel>& in, std::vector<char>& has_unary, Orientation_result& result)
+                         const Core_points<Kernel>& in, const std::vector<double>& cue, std::vector<char>& has_unary,
+                         Orientation_result& result)
 {
   if constexpr (WithUnary) {
     typedef std::pair<double, double> Costs;
-    typedef decltype(boost::make_iterator_property_map(std::declval<std::vector<Costs>&>().begin(),
-                                                       get(boost::vertex_index, graph)))
-      Unary_map;
-    static_assert(Accepts_unary<Solver, Neighbor_graph, WeightMap, Unary_map, LabelMap>::value,
+    static_assert(Accepts_core_unary<Solver, WeightMap, LabelMap>::value,
                   "orient_normals: point_is_constrained_map and orientation_prior_map need a solver with "
                   "solve(graph, weight, unary, labels)");
     const std::size_t n = in.points.size();
@@ -231,7 +243,7 @@ Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, Weig
     std::vector<Costs> unary(n, Costs(0.0, 0.0));
     has_unary.assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
-      double a = in.prior.empty() ? 0.0 : in.prior[i]; // > 0: keep (label +1)
+      double a = (in.prior.empty() ? 0.0 : in.prior[i]) + (cue.empty() ? 0.0 : cue[i]); // > 0: keep (label +1)
       if (!in.constrained.empty() && in.constrained[i])
         a = hard;
       if (a != 0.0 && in.normals[i] != CGAL::NULL_VECTOR) {
@@ -244,10 +256,54 @@ Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, Weig
                         label_map);
   } else {
     (void)in;
+    (void)cue;
     (void)has_unary;
     (void)result;
     return solver.solve(graph, weight, label_map);
   }
+}
+
+/// Copies what the graph's construction reports to `result`.
+inline void add_graph_report(const Neighbor_graph_report& gr, Orientation_result& result)
+{
+  result.number_of_edges = gr.number_of_edges;
+  result.number_of_neighbors = gr.number_of_neighbors;
+  result.neighbor_radius = gr.radius;
+  result.radius_estimated = gr.radius_estimated;
+  result.konig_disagreement = gr.konig_disagreement;
+  result.konig_everywhere = gr.konig_everywhere;
+  result.seconds.neighbors = gr.seconds_neighbors;
+  result.seconds.graph = gr.seconds_graph;
+}
+
+/// The component signs of the labelling `labels` of `graph` (step 4):
+/// writes the components to `component` and negates the components that
+/// `sign_policy` negates, except those that the unary terms fix.  After a
+/// solve with the layer cues `cue` (per point, or empty), `has_unary` marks
+/// the cues' points: they move to `cued`, and `cue_fixed` marks the points
+/// of the components that the cues fix (`cue_components()`).
+template <typename Kernel, typename WeightMap, typename SignPolicy>
+void core_component_signs(const Neighbor_graph& graph, WeightMap weight, const SignPolicy& sign_policy,
+                          const Core_points<Kernel>& in, double radius, bool has_constraints,
+                          const std::vector<double>& cue, std::vector<char>& has_unary, std::vector<char>& cued,
+                          std::vector<char>& cue_fixed, std::vector<std::uint32_t>& component,
+                          std::vector<Label>& labels, Orientation_result& result)
+{
+  result.number_of_components = connected_components(graph, weight, component);
+  if (!cue.empty()) {
+    cued.swap(has_unary);
+    cue_fixed = cue_components(cue, component, result.number_of_components, labels);
+  }
+  const Component_sign_input<Kernel> input{in.points, in.normals, labels, component, result.number_of_components,
+                                           radius, has_constraints ? &in.constrained : nullptr};
+  std::vector<char> flip = component_signs(sign_policy, input);
+  for (const std::vector<char>* fixed : {&has_unary, &cue_fixed}) // (the solver gave these components their sign)
+    for (std::size_t i = 0; i < fixed->size(); ++i)
+      if ((*fixed)[i])
+        flip[component[i]] = 0;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (flip[component[i]])
+      labels[i] = Label(-labels[i]);
 }
 
 } // namespace internal
@@ -423,14 +479,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         build_neighbor_graph<ConcurrencyTag, Kernel>(in.points, in.normals, settings.number_of_neighbors,
                                                      settings.neighbor_radius, criterion, graph,
                                                      progress.part(Stage::GRAPH, 0.0, 0.8));
-      result.number_of_edges = gr.number_of_edges;
-      result.number_of_neighbors = gr.number_of_neighbors;
-      result.neighbor_radius = gr.radius;
-      result.radius_estimated = gr.radius_estimated;
-      result.konig_disagreement = gr.konig_disagreement;
-      result.konig_everywhere = gr.konig_everywhere;
-      result.seconds.neighbors = gr.seconds_neighbors;
-      result.seconds.graph = gr.seconds_graph;
+      internal::add_graph_report(gr, result);
       const auto weight = get(&Neighbor_edge::weight, graph);
       std::vector<Label> labels(n, Label(1));
       const auto label_map = CGAL::make_property_map(labels);
@@ -441,15 +490,31 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       // The field's samples are dense where the input normals agree (the
       // coarse pass does not run), except on the pass's own coarse cloud.
       std::vector<char> has_unary; // per vertex, with unary terms only
+      std::vector<double> cue_unary; // per vertex, the layer cues' unary terms (empty: none)
       constexpr bool coarse_cloud =
         internal::Is_coarse_cloud_point<typename std::iterator_traits<decltype(points.begin())>::value_type>::value;
+      // Layer cues: not with the user's unary terms, nor on the coarse pass's own cloud.
+      constexpr bool cues_possible =
+        !has_constraints && !has_prior && !coarse_cloud &&
+        internal::Accepts_core_unary<std::decay_t<decltype(solver)>, decltype(weight), decltype(label_map)>::value;
+      bool want_cues = cues_possible && policies.global.orientation != Global_orientation::NONE;
+      internal::Layer_cue_report cue_report;
+      bool last_dense = true;
       auto fine = [&](const auto& the_solver, bool, bool dense) {
+        last_dense = dense;
         internal::Global_settings global = policies.global;
         global.dense_samples = dense && !coarse_cloud;
         auto t = std::chrono::steady_clock::now();
         std::fill(labels.begin(), labels.end(), Label(1));
-        const Solver_report sr = internal::solve_core<has_constraints || has_prior>(the_solver, graph, weight, label_map,
-                                                                                    in, has_unary, result);
+        Solver_report sr;
+        typedef std::decay_t<decltype(the_solver)> The_solver;
+        if constexpr (internal::Accepts_core_unary<The_solver, decltype(weight), decltype(label_map)>::value) {
+          if (!cue_unary.empty())
+            sr = internal::solve_core<true>(the_solver, graph, weight, label_map, in, cue_unary, has_unary, result);
+        }
+        if (cue_unary.empty())
+          sr = internal::solve_core<has_constraints || has_prior>(the_solver, graph, weight, label_map, in, cue_unary,
+                                                                  has_unary, result);
         result.frustrated_edges = sr.frustrated_edges;
         result.number_of_segments = sr.segments;
         const std::vector<char> moved = internal::solver_moves(labels, sr.starting_labels);
@@ -458,23 +523,17 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
 
         t = std::chrono::steady_clock::now();
         std::vector<std::uint32_t> component;
-        result.number_of_components = connected_components(graph, weight, component);
-        const Component_sign_input<Kernel> input{in.points, in.normals, labels, component, result.number_of_components,
-                                                 gr.radius, has_constraints ? &in.constrained : nullptr};
-        std::vector<char> flip = component_signs(sign_policy, input);
-        for (std::size_t i = 0; i < has_unary.size(); ++i) // the solver gave these components their sign
-          if (has_unary[i])
-            flip[component[i]] = 0;
-        for (std::size_t i = 0; i < n; ++i)
-          if (flip[component[i]])
-            labels[i] = Label(-labels[i]);
+        std::vector<char> cued, cue_fixed; // (the layer cues' points, and those of the components they fix)
+        internal::core_component_signs(graph, weight, sign_policy, in, gr.radius, has_constraints, cue_unary,
+                                       has_unary, cued, cue_fixed, component, labels, result);
         result.seconds.sign += internal::seconds_since(t);
         progress.part(Stage::SIGN, 0.9, 0.92).report(1.0);
 
         if (policies.global.orientation != Global_orientation::NONE) {
           progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
           result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(
-            graph, in.points, in.normals, component, gr.radius, has_unary, moved, global, labels);
+            graph, in.points, in.normals, component, gr.radius, has_unary, cued, cue_fixed, moved, global, labels,
+            want_cues && dense ? &cue_report : nullptr); // (no cues where noise hides the layers)
           result.seconds.global += result.global.seconds;
         }
       };
@@ -488,11 +547,30 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
             .global.closedness;
         };
         const bool before = internal::solve_around_coarse_pass(pass.runs(), solver, fine, [&]() {
-          return pass.apply(labels, result.global.closedness, orient_coarse);
+          const bool taken = pass.apply(labels, result.global.closedness, orient_coarse);
+          if (taken) // (the cues were of the fine labels)
+            cue_report.unary.clear();
+          return taken;
         });
         pass.add_report(before, result.global, result.seconds.global);
       } else {
         fine(solver, true, true);
+      }
+      // 6. Layer cues: where two layers lie closer than the neighbour
+      // distance, the far field decides their signs (Layer_cues.h); the
+      // solver and the stage run once more with the cues as unary terms when
+      // they negate enough points.
+      if (want_cues) {
+        const bool round = double(cue_report.against) > internal::layer_cue_round_share * double(n);
+        if (round) {
+          cue_unary.swap(cue_report.unary);
+          want_cues = false;
+          fine(solver, true, last_dense);
+        }
+        result.global.layer_pairs = cue_report.pairs;
+        result.global.layer_cues = cue_report.sure;
+        result.global.layer_cues_against = cue_report.against;
+        result.global.layer_cue_round = round;
       }
       result.energy_after = energy(graph, weight, label_map);
       for (std::size_t q = 0; q < n; ++q)

@@ -14,8 +14,10 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Signed_union_find.h>
 #include <Normal_orientation/Winding_number_field.h>
+#include <Normal_orientation/internal/Core_layer_cues.h>
 #include <Normal_orientation/internal/Graph_reduction.h>
 #include <Normal_orientation/internal/Parallel.h>
+#include <Normal_orientation/internal/Seen_side_rules.h>
 
 #include <algorithm>
 #include <array>
@@ -294,191 +296,18 @@ inline void add_level(Global_sign_summary& total, const Global_sign_summary& lev
   total.energy_after = level.energy_after;
 }
 
-/// What the drivers' global stage does: its mode, and the up direction of
-/// exterior visibility (zero: none).
-struct Global_settings
-{
-  Global_orientation orientation = Global_orientation::NONE;
-  std::array<double, 3> up = {{0.0, 0.0, 1.0}};
-  /// the field's samples: `global_samples()` with `dense`, where the input
-  /// normals agree at their own spacing (the drivers' fine step, when the
-  /// coarse-to-fine pass does not run)
-  bool dense_samples = false;
-  /// the options of `exterior_visibility()`
-  Exterior_visibility_options visibility() const
-  {
-    Exterior_visibility_options o;
-    o.up = up;
-    return o;
-  }
-};
-
-/// `v` as an array (the `up_direction` parameter: a `std::array<double, 3>`)
-inline std::array<double, 3> direction_array(const std::array<double, 3>& v) { return v; }
-/// `v` as an array (the `up_direction` parameter: a vector with x(), y(), z())
-template <typename Vector>
-std::array<double, 3> direction_array(const Vector& v)
-{
-  return {{double(v.x()), double(v.y()), double(v.z())}};
-}
-
-/// The decisions of exterior visibility.
-struct Seen_side_flips
-{
-  std::vector<char> component; ///< per component id: the whole component negates
-  std::vector<char> patch;     ///< per patch id: the patch negates (after its component)
-  std::vector<double> vote;    ///< per sample: `exterior_visibility()` of the input orientation
-  std::size_t components_flipped = 0;
-  std::size_t patches_flipped = 0;
-};
-
-/// The components (ids below `number_of_components`, those of `fixed`
-/// left out) that face away from the side they were seen from
-/// (`exterior_visibility()` of the samples, with their oriented normals),
-/// then the patches of `sample_patch` that still do; nothing unless
-/// `settings` asks for visibility.
-template <typename ConcurrencyTag, typename Point, typename Vector>
-Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vector<Vector>& oriented,
-                                const std::vector<double>& areas, const std::vector<std::uint32_t>& sample_component,
-                                const std::vector<std::uint32_t>& sample_patch, std::size_t number_of_components,
-                                std::size_t number_of_patches, const std::vector<char>& fixed,
-                                const Global_settings& settings)
-{
-  Seen_side_flips out;
-  out.component.assign(number_of_components, 0);
-  out.patch.assign(number_of_patches, 0);
-  out.vote.assign(points.size(), 0.0);
-  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
-    return out;
-  std::vector<char> free_component(number_of_components, 1), free_patch(number_of_patches, 0);
-  for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
-    free_component[c] = !fixed[c];
-  out.vote = exterior_visibility<ConcurrencyTag>(points, oriented, areas, settings.visibility());
-  std::vector<double> vote = out.vote;
-  out.component = visibility_flips(vote, areas, sample_component, free_component, 0.01);
-  for (std::size_t j = 0; j < vote.size(); ++j) {
-    free_patch[sample_patch[j]] = free_component[sample_component[j]];
-    if (out.component[sample_component[j]])
-      vote[j] = -vote[j];
-  }
-  out.patch = visibility_flips(vote, areas, sample_patch, free_patch);
-  for (char f : out.component)
-    out.components_flipped += f ? 1 : 0;
-  for (char f : out.patch)
-    out.patches_flipped += f ? 1 : 0;
-  return out;
-}
-
-/// The segments' tier of exterior visibility, after the components and the
-/// sheets of `seen`: the segments (`sample_segment`, per sample, below
-/// `number_of_segments`) that still face away from where they were seen,
-/// both by the votes of `seen` (views below the horizon weigh less) and by
-/// views that all weigh 1 (`normals`: the orientation that `seen` voted
-/// on).  The solvers' errors are whole segments; but the lower part of an
-/// object scanned from one side faces down, and the views from above see it
-/// from behind, through the open back: only they would turn it.  (The
-/// views of weight 1 are drawn only where the first votes turn a segment
-/// and there is an up direction.)  Nothing unless `settings` asks for
-/// visibility.
-template <typename ConcurrencyTag, typename Point, typename Vector>
-std::vector<char> segment_tier_flips(const std::vector<Point>& points, const std::vector<Vector>& normals,
-                                     const std::vector<double>& areas,
-                                     const std::vector<std::uint32_t>& sample_component,
-                                     const std::vector<std::uint32_t>& sample_sheet,
-                                     const std::vector<std::uint32_t>& sample_segment, std::size_t number_of_segments,
-                                     const Seen_side_flips& seen, const std::vector<char>& component_fixed,
-                                     const Global_settings& settings)
-{
-  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
-    return std::vector<char>(number_of_segments, 0);
-  // (the votes as they stand after the components and sheets of `seen`)
-  auto after_seen = [&](std::vector<double> v) {
-    for (std::size_t j = 0; j < points.size(); ++j)
-      if (seen.component[sample_component[j]] != seen.patch[sample_sheet[j]])
-        v[j] = -v[j];
-    return v;
-  };
-  std::vector<char> free_segment(number_of_segments, 0);
-  for (std::size_t j = 0; j < points.size(); ++j)
-    free_segment[sample_segment[j]] = !component_fixed[sample_component[j]];
-  std::vector<char> flip = visibility_flips(after_seen(seen.vote), areas, sample_segment, free_segment);
-  const Exterior_visibility_options weighted = settings.visibility();
-  if (std::find(flip.begin(), flip.end(), 1) == flip.end() || weighted.up == std::array<double, 3>{{0.0, 0.0, 0.0}})
-    return flip; // (nothing to confirm, or every view already weighs 1)
-  Exterior_visibility_options even = weighted;
-  even.up = {{0.0, 0.0, 0.0}}; // (every view weighs 1)
-  const std::vector<char> even_flip = visibility_flips(
-    after_seen(exterior_visibility<ConcurrencyTag>(points, normals, areas, even)), areas, sample_segment, free_segment);
-  for (std::size_t P = 0; P < flip.size(); ++P)
-    flip[P] = char(flip[P] && even_flip[P]);
-  return flip;
-}
-
-/// The segments of the labelling `labels` on `graph` (`reduce_to_segments()`:
-/// the paper's segmentation with its default thresholds, in vertex order, in
-/// the frame where `labels` is all +1): regions that the labelling made
-/// consistent, as the streamed driver's final segments are.  Writes the
-/// segment of every vertex to `segment`; returns their number.
-inline std::size_t labelling_segments(const Neighbor_graph& graph, const std::vector<Label>& labels,
+/// The segments of the labelling `labels` on the graph of incidence lists
+/// `inc` (`reduce_to_segments()`: the paper's segmentation with its default
+/// thresholds, in vertex order, in the frame where `labels` is all +1):
+/// regions that the labelling made consistent, as the streamed driver's
+/// final segments are.  Writes the segment of every vertex to `segment`;
+/// returns their number.
+inline std::size_t labelling_segments(const Incidence& inc, const std::vector<Label>& labels,
                                       std::vector<std::uint32_t>& segment)
 {
-  Segment_reduction r =
-    reduce_to_segments(Incidence(graph, get(&Neighbor_edge::weight, graph), "the global stage"),
-                       std::vector<double>(), labels);
+  Segment_reduction r = reduce_to_segments(inc, std::vector<double>(), labels);
   segment = std::move(r.segment);
   return r.reduced.number_of_vertices;
-}
-
-/// The components (ids below `number_of_components`, those of `fixed` left
-/// out) whose top surface faces down (`downward_top_flips()` of
-/// `top_view_facing()` of the samples, with their final oriented normals);
-/// nothing unless `settings` asks for visibility.  A closed surface's top
-/// faces up, and so does the ground of a scene seen from above or from the
-/// ground: this undoes the winding number where it takes a scene open to
-/// the sky (a street between facades) for part of a closed surface.
-template <typename ConcurrencyTag, typename Point, typename Vector>
-std::vector<char> top_side_flips(const std::vector<Point>& points, const std::vector<Vector>& oriented,
-                                 const std::vector<double>& areas, const std::vector<std::uint32_t>& sample_component,
-                                 std::size_t number_of_components, const std::vector<char>& fixed,
-                                 const Global_settings& settings)
-{
-  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
-    return std::vector<char>(number_of_components, 0);
-  std::vector<char> eligible(number_of_components, 1);
-  for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
-    eligible[c] = !fixed[c];
-  return downward_top_flips(top_view_facing<ConcurrencyTag>(points, oriented, areas, settings.visibility()), areas,
-                            sample_component, eligible);
-}
-
-/// Whether the winding number negated a sample against both the solver and
-/// exterior visibility: it negated it (`by_winding`), visibility did not
-/// (`by_visibility`).
-inline bool negated_against_both(char by_visibility, char by_winding) { return by_winding && !by_visibility; }
-
-/// The sheets (groups of `sample_group`) where the winding number's flips
-/// are undone: where it negated samples against both the solver and
-/// exterior visibility (`negated_against_both()`; per sample, whether
-/// visibility negated it, `by_visibility`, and whether the winding number
-/// negated it after that, `by_winding`), and these samples, with their
-/// final signs, face away from the side they were seen from (their
-/// area-weighted mean `vote`, of their input orientation, is below
-/// `-margin`).  Where visibility negated a sheet and the winding number
-/// negates it back, the solver and the winding number outvote it.
-inline std::vector<char> seen_side_vetoes(const std::vector<double>& vote, const std::vector<double>& areas,
-                                          const std::vector<std::uint32_t>& sample_group,
-                                          const std::vector<char>& by_visibility, const std::vector<char>& by_winding,
-                                          std::size_t number_of_groups, double margin = 0.01)
-{
-  std::vector<char> eligible(number_of_groups, 0);
-  std::vector<double> final_vote(vote.size(), 0.0), area(vote.size(), 0.0);
-  for (std::size_t j = 0; j < vote.size(); ++j)
-    if (negated_against_both(by_visibility[j], by_winding[j])) {
-      eligible[sample_group[j]] = 1;
-      final_vote[j] = (by_visibility[j] != by_winding[j] ? -1.0 : 1.0) * vote[j];
-      area[j] = areas[j];
-    }
-  return visibility_flips(final_vote, area, sample_group, eligible, margin);
 }
 
 /// The samples of the in-core global stage: every stride-th point of the
@@ -575,15 +404,21 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
 /// seen; the winding number then negates patches, level by level, and its
 /// flips against both the solver and visibility are undone in the sheets
 /// they turn away from where they were seen (`seen_side_vetoes()`).
-/// Components with a point of `has_unary` keep their signs; no patch joins
+/// Components with a point of `has_unary` keep their signs.  The layer
+/// cues' points (`cued`, per point, or empty) keep the signs of their
+/// sheets, segments and patches against their component, and the
+/// components with a point of `cue_fixed` (per point, or empty) keep theirs
+/// as a whole (`cue_components()`); no patch joins
 /// points that the solver negated against its start with points that it
 /// kept (`moved`, per point; empty: no start).
 template <typename ConcurrencyTag, typename Kernel>
 Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                                       const std::vector<typename Kernel::Vector_3>& normals,
                                       const std::vector<std::uint32_t>& component, double radius,
-                                      const std::vector<char>& has_unary, const std::vector<char>& moved,
-                                      const Global_settings& settings, std::vector<Label>& labels)
+                                      const std::vector<char>& has_unary, const std::vector<char>& cued,
+                                      const std::vector<char>& cue_fixed, const std::vector<char>& moved,
+                                      const Global_settings& settings,
+                                      std::vector<Label>& labels, Layer_cue_report* cues = nullptr)
 {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = points.size();
@@ -598,6 +433,10 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   for (std::size_t i = 0; i < has_unary.size(); ++i)
     if (has_unary[i])
       component_fixed[component[i]] = 1;
+  std::vector<char> whole_fixed(nc, 0); // (components fixed as a whole: their sheets are free)
+  for (std::size_t i = 0; i < cue_fixed.size(); ++i)
+    if (cue_fixed[i])
+      whole_fixed[component[i]] = 1;
   const std::vector<float> slopes = edge_slopes<Kernel, ConcurrencyTag>(graph, points, normals);
   // 1. Exterior visibility.
   std::size_t number_of_sheets = 0;
@@ -609,11 +448,19 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
     sample_sheet[t] = sheet[samples.index[t]];
   Seen_side_flips seen = seen_side_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
                                                          samples.component, sample_sheet, nc, number_of_sheets,
-                                                         component_fixed, settings);
+                                                         component_fixed, settings, whole_fixed);
   std::vector<std::uint32_t> segment, sample_segment(ns);
+  std::size_t number_of_segments = 0;
   std::vector<char> segment_flip;
+  Layer_pairs pairs; // (of the layer cues)
+  if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING || cues) {
+    const Incidence inc(graph, get(&Neighbor_edge::weight, graph), "the global stage");
+    if (cues)
+      pairs = core_layer_pairs<ConcurrencyTag>(inc, points, normals);
+    if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING)
+      number_of_segments = labelling_segments(inc, labels, segment);
+  }
   if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING) {
-    const std::size_t number_of_segments = labelling_segments(graph, labels, segment);
     for (std::size_t t = 0; t < ns; ++t)
       sample_segment[t] = segment[samples.index[t]];
     segment_flip = segment_tier_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
@@ -622,6 +469,12 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
     for (char f : segment_flip)
       seen.patches_flipped += f ? 1 : 0;
   }
+  for (std::size_t i = 0; i < cued.size(); ++i)
+    if (cued[i]) {
+      seen.patch[sheet[i]] = 0;
+      if (!segment_flip.empty())
+        segment_flip[segment[i]] = 0;
+    }
   auto seen_flip = [&](std::uint32_t c, std::uint32_t sheet_id, std::uint32_t segment_id) {
     return (seen.component[c] != seen.patch[sheet_id]) != (!segment_flip.empty() && segment_flip[segment_id]);
   };
@@ -636,7 +489,13 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   Global_sign_summary report;
   // (visibility flipped nothing: the sheets are the winding number's first level)
   const bool unchanged = seen.components_flipped == 0 && seen.patches_flipped == 0;
-  core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, slopes, component, radius, has_unary,
+  std::vector<char> keep = has_unary; // (the patches that keep their signs)
+  if (!cued.empty()) {
+    keep.resize(n, 0);
+    for (std::size_t i = 0; i < n; ++i)
+      keep[i] = char(keep[i] || cued[i]);
+  }
+  core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, slopes, component, radius, keep,
                                               moved, samples, unchanged ? sheet : std::vector<std::uint32_t>(),
                                               number_of_sheets, labels, report);
   // 3. Its flips against both the solver and visibility, in the sheets they
@@ -656,13 +515,22 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   // 4. Components whose top surface faces down are negated.
   for (std::size_t t = 0; t < ns; ++t)
     samples.oriented[t] = labels[samples.index[t]] < 0 ? -normals[samples.index[t]] : normals[samples.index[t]];
+  for (std::size_t c = 0; c < nc; ++c)
+    whole_fixed[c] = char(whole_fixed[c] || component_fixed[c]);
   const std::vector<char> top = top_side_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
-                                                               samples.component, nc, component_fixed, settings);
+                                                               samples.component, nc, whole_fixed, settings);
   for (std::size_t i = 0; i < n; ++i)
     if (top[component[i]])
       labels[i] = Label(-labels[i]);
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
+  // 5. The layer cues of the final signs.
+  if (cues) {
+    for (std::size_t t = 0; t < ns; ++t)
+      if (top[samples.component[t]])
+        samples.oriented[t] = -samples.oriented[t];
+    *cues = core_layer_cues<ConcurrencyTag, Kernel>(pairs, points, normals, labels, samples);
+  }
   report.visibility = settings.orientation == Global_orientation::VISIBILITY_AND_WINDING;
   report.seen_components_flipped = seen.components_flipped;
   report.seen_patches_flipped = seen.patches_flipped;

@@ -1,0 +1,205 @@
+// SPDX-License-Identifier: GPL-3.0-or-later
+// This file is part of Normal_orientation.
+#ifndef NORMAL_ORIENTATION_INTERNAL_SEEN_SIDE_RULES_H
+#define NORMAL_ORIENTATION_INTERNAL_SEEN_SIDE_RULES_H
+
+/// \file Seen_side_rules.h
+/// The rules of the global stage that both drivers share around exterior
+/// visibility: its settings, the components, sheets and segments that face
+/// away from the side they were seen from, the vetoes on the winding
+/// number's flips, and the components whose top surface faces down.
+
+#include <Normal_orientation/Exterior_visibility.h>
+#include <Normal_orientation/Global_sign.h>
+
+#include <algorithm>
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+/// \cond SKIP_IN_MANUAL
+namespace Normal_orientation {
+namespace internal {
+
+/// What the drivers' global stage does: its mode, and the up direction of
+/// exterior visibility (zero: none).
+struct Global_settings
+{
+  Global_orientation orientation = Global_orientation::NONE;
+  std::array<double, 3> up = {{0.0, 0.0, 1.0}};
+  /// the field's samples: `global_samples()` with `dense`, where the input
+  /// normals agree at their own spacing (the drivers' fine step, when the
+  /// coarse-to-fine pass does not run)
+  bool dense_samples = false;
+  /// the options of `exterior_visibility()`
+  Exterior_visibility_options visibility() const
+  {
+    Exterior_visibility_options o;
+    o.up = up;
+    return o;
+  }
+};
+
+/// `v` as an array (the `up_direction` parameter: a `std::array<double, 3>`)
+inline std::array<double, 3> direction_array(const std::array<double, 3>& v) { return v; }
+/// `v` as an array (the `up_direction` parameter: a vector with x(), y(), z())
+template <typename Vector>
+std::array<double, 3> direction_array(const Vector& v)
+{
+  return {{double(v.x()), double(v.y()), double(v.z())}};
+}
+
+/// The decisions of exterior visibility.
+struct Seen_side_flips
+{
+  std::vector<char> component; ///< per component id: the whole component negates
+  std::vector<char> patch;     ///< per patch id: the patch negates (after its component)
+  std::vector<double> vote;    ///< per sample: `exterior_visibility()` of the input orientation
+  std::size_t components_flipped = 0;
+  std::size_t patches_flipped = 0;
+};
+
+/// The components (ids below `number_of_components`, those of `fixed` and
+/// `whole_fixed` left out) that face away from the side they were seen from
+/// (`exterior_visibility()` of the samples, with their oriented normals),
+/// then the patches of `sample_patch` that still do (those of the
+/// components of `fixed` left out); nothing unless `settings` asks for
+/// visibility.
+template <typename ConcurrencyTag, typename Point, typename Vector>
+Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vector<Vector>& oriented,
+                                const std::vector<double>& areas, const std::vector<std::uint32_t>& sample_component,
+                                const std::vector<std::uint32_t>& sample_patch, std::size_t number_of_components,
+                                std::size_t number_of_patches, const std::vector<char>& fixed,
+                                const Global_settings& settings, const std::vector<char>& whole_fixed = {})
+{
+  Seen_side_flips out;
+  out.component.assign(number_of_components, 0);
+  out.patch.assign(number_of_patches, 0);
+  out.vote.assign(points.size(), 0.0);
+  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
+    return out;
+  std::vector<char> free_component(number_of_components, 1), free_patch(number_of_patches, 0);
+  for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
+    free_component[c] = !fixed[c];
+  out.vote = exterior_visibility<ConcurrencyTag>(points, oriented, areas, settings.visibility());
+  std::vector<double> vote = out.vote;
+  std::vector<char> free_whole = free_component;
+  for (std::size_t c = 0; c < whole_fixed.size() && c < number_of_components; ++c)
+    free_whole[c] = char(free_whole[c] && !whole_fixed[c]);
+  out.component = visibility_flips(vote, areas, sample_component, free_whole, 0.01);
+  for (std::size_t j = 0; j < vote.size(); ++j) {
+    free_patch[sample_patch[j]] = free_component[sample_component[j]];
+    if (out.component[sample_component[j]])
+      vote[j] = -vote[j];
+  }
+  out.patch = visibility_flips(vote, areas, sample_patch, free_patch);
+  for (char f : out.component)
+    out.components_flipped += f ? 1 : 0;
+  for (char f : out.patch)
+    out.patches_flipped += f ? 1 : 0;
+  return out;
+}
+
+/// The segments' tier of exterior visibility, after the components and the
+/// sheets of `seen`: the segments (`sample_segment`, per sample, below
+/// `number_of_segments`) that still face away from where they were seen,
+/// both by the votes of `seen` (views below the horizon weigh less) and by
+/// views that all weigh 1 (`normals`: the orientation that `seen` voted
+/// on).  The solvers' errors are whole segments; but the lower part of an
+/// object scanned from one side faces down, and the views from above see it
+/// from behind, through the open back: only they would turn it.  (The
+/// views of weight 1 are drawn only where the first votes turn a segment
+/// and there is an up direction.)  Nothing unless `settings` asks for
+/// visibility.
+template <typename ConcurrencyTag, typename Point, typename Vector>
+std::vector<char> segment_tier_flips(const std::vector<Point>& points, const std::vector<Vector>& normals,
+                                     const std::vector<double>& areas,
+                                     const std::vector<std::uint32_t>& sample_component,
+                                     const std::vector<std::uint32_t>& sample_sheet,
+                                     const std::vector<std::uint32_t>& sample_segment, std::size_t number_of_segments,
+                                     const Seen_side_flips& seen, const std::vector<char>& component_fixed,
+                                     const Global_settings& settings)
+{
+  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
+    return std::vector<char>(number_of_segments, 0);
+  // (the votes as they stand after the components and sheets of `seen`)
+  auto after_seen = [&](std::vector<double> v) {
+    for (std::size_t j = 0; j < points.size(); ++j)
+      if (seen.component[sample_component[j]] != seen.patch[sample_sheet[j]])
+        v[j] = -v[j];
+    return v;
+  };
+  std::vector<char> free_segment(number_of_segments, 0);
+  for (std::size_t j = 0; j < points.size(); ++j)
+    free_segment[sample_segment[j]] = !component_fixed[sample_component[j]];
+  std::vector<char> flip = visibility_flips(after_seen(seen.vote), areas, sample_segment, free_segment);
+  const Exterior_visibility_options weighted = settings.visibility();
+  if (std::find(flip.begin(), flip.end(), 1) == flip.end() || weighted.up == std::array<double, 3>{{0.0, 0.0, 0.0}})
+    return flip; // (nothing to confirm, or every view already weighs 1)
+  Exterior_visibility_options even = weighted;
+  even.up = {{0.0, 0.0, 0.0}}; // (every view weighs 1)
+  const std::vector<char> even_flip = visibility_flips(
+    after_seen(exterior_visibility<ConcurrencyTag>(points, normals, areas, even)), areas, sample_segment, free_segment);
+  for (std::size_t P = 0; P < flip.size(); ++P)
+    flip[P] = char(flip[P] && even_flip[P]);
+  return flip;
+}
+
+/// The components (ids below `number_of_components`, those of `fixed` left
+/// out) whose top surface faces down (`downward_top_flips()` of
+/// `top_view_facing()` of the samples, with their final oriented normals);
+/// nothing unless `settings` asks for visibility.  A closed surface's top
+/// faces up, and so does the ground of a scene seen from above or from the
+/// ground: this undoes the winding number where it takes a scene open to
+/// the sky (a street between facades) for part of a closed surface.
+template <typename ConcurrencyTag, typename Point, typename Vector>
+std::vector<char> top_side_flips(const std::vector<Point>& points, const std::vector<Vector>& oriented,
+                                 const std::vector<double>& areas, const std::vector<std::uint32_t>& sample_component,
+                                 std::size_t number_of_components, const std::vector<char>& fixed,
+                                 const Global_settings& settings)
+{
+  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
+    return std::vector<char>(number_of_components, 0);
+  std::vector<char> eligible(number_of_components, 1);
+  for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
+    eligible[c] = !fixed[c];
+  return downward_top_flips(top_view_facing<ConcurrencyTag>(points, oriented, areas, settings.visibility()), areas,
+                            sample_component, eligible);
+}
+
+/// Whether the winding number negated a sample against both the solver and
+/// exterior visibility: it negated it (`by_winding`), visibility did not
+/// (`by_visibility`).
+inline bool negated_against_both(char by_visibility, char by_winding) { return by_winding && !by_visibility; }
+
+/// The sheets (groups of `sample_group`) where the winding number's flips
+/// are undone: where it negated samples against both the solver and
+/// exterior visibility (`negated_against_both()`; per sample, whether
+/// visibility negated it, `by_visibility`, and whether the winding number
+/// negated it after that, `by_winding`), and these samples, with their
+/// final signs, face away from the side they were seen from (their
+/// area-weighted mean `vote`, of their input orientation, is below
+/// `-margin`).  Where visibility negated a sheet and the winding number
+/// negates it back, the solver and the winding number outvote it.
+inline std::vector<char> seen_side_vetoes(const std::vector<double>& vote, const std::vector<double>& areas,
+                                          const std::vector<std::uint32_t>& sample_group,
+                                          const std::vector<char>& by_visibility, const std::vector<char>& by_winding,
+                                          std::size_t number_of_groups, double margin = 0.01)
+{
+  std::vector<char> eligible(number_of_groups, 0);
+  std::vector<double> final_vote(vote.size(), 0.0), area(vote.size(), 0.0);
+  for (std::size_t j = 0; j < vote.size(); ++j)
+    if (negated_against_both(by_visibility[j], by_winding[j])) {
+      eligible[sample_group[j]] = 1;
+      final_vote[j] = (by_visibility[j] != by_winding[j] ? -1.0 : 1.0) * vote[j];
+      area[j] = areas[j];
+    }
+  return visibility_flips(final_vote, area, sample_group, eligible, margin);
+}
+
+} // namespace internal
+} // namespace Normal_orientation
+/// \endcond
+
+#endif // NORMAL_ORIENTATION_INTERNAL_SEEN_SIDE_RULES_H
