@@ -133,6 +133,13 @@ Global_sign_summary decide_patch_signs(const std::vector<Point>& points, const s
 /// \cond SKIP_IN_MANUAL
 namespace internal {
 
+/// The median of `values` (not empty): the upper one of an even count.
+inline double median(std::vector<double> values)
+{
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(values.size() / 2), values.end());
+  return values[values.size() / 2];
+}
+
 /// Caps every area at 16 times the median: an isolated point (an outlier,
 /// a tiny far component) would otherwise stand for a huge area and drown
 /// the field of the surfaces.
@@ -140,9 +147,7 @@ inline void cap_areas(std::vector<double>& areas)
 {
   if (areas.empty())
     return;
-  std::vector<double> sorted(areas);
-  std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() / 2), sorted.end());
-  const double cap = 16.0 * sorted[sorted.size() / 2];
+  const double cap = 16.0 * median(areas);
   for (double& a : areas)
     a = std::min(a, cap);
 }

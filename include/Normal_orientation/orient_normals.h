@@ -499,9 +499,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         internal::Accepts_core_unary<std::decay_t<decltype(solver)>, decltype(weight), decltype(label_map)>::value;
       bool want_cues = cues_possible && policies.global.orientation != Global_orientation::NONE;
       internal::Layer_cue_report cue_report;
-      bool last_dense = true;
       auto fine = [&](const auto& the_solver, bool, bool dense) {
-        last_dense = dense;
         internal::Global_settings global = policies.global;
         global.dense_samples = dense && !coarse_cloud;
         auto t = std::chrono::steady_clock::now();
@@ -565,7 +563,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         if (round) {
           cue_unary.swap(cue_report.unary);
           want_cues = false;
-          fine(solver, true, last_dense);
+          fine(solver, true, true); // (cues come only from the dense step: the pass did not run)
         }
         result.global.layer_pairs = cue_report.pairs;
         result.global.layer_cues = cue_report.sure;

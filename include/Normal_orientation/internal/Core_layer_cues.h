@@ -9,13 +9,13 @@
 /// far field from the stage's samples with their final signs, and the cues
 /// as unary terms for one more solve.
 
+#include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Winding_number_field.h>
 #include <Normal_orientation/internal/Graph_reduction.h>
 #include <Normal_orientation/internal/Layer_cues.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -31,7 +31,6 @@ struct Layer_cue_report
   std::size_t pairs = 0;     ///< points whose neighbourhood is two layers
   std::size_t sure = 0;      ///< of them, with a sure cue
   std::size_t against = 0;   ///< of them, whose label the cue negates
-  double seconds = 0.0;      ///< the time they took
   /// per point, the cue's label times the total weight of the point's edges
   /// (a cue outweighs its point's edges), 0 without a sure cue; empty when
   /// no point has one
@@ -67,15 +66,12 @@ Layer_cue_report core_layer_cues(const Layer_pairs& pairs, const std::vector<typ
                                  const std::vector<typename Kernel::Vector_3>& normals,
                                  const std::vector<Label>& labels, const Samples& samples)
 {
-  const auto t0 = std::chrono::steady_clock::now();
   Layer_cue_report report;
   report.pairs = pairs.size();
   if (pairs.size() > 0 && !samples.points.empty()) {
     Winding_number_field<Kernel> field;
     field.template build<ConcurrencyTag>(samples.points, samples.oriented, samples.areas);
-    std::vector<double> a = samples.areas;
-    std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
-    const double spacing = std::sqrt(a[a.size() / 2]);
+    const double spacing = std::sqrt(median(samples.areas));
     const std::vector<Label> cue = layer_cues<ConcurrencyTag, Kernel>(normals, pairs, points, field, spacing);
     for (std::size_t t = 0; t < pairs.size(); ++t) {
       if (cue[t] == 0)
@@ -89,7 +85,6 @@ Layer_cue_report core_layer_cues(const Layer_pairs& pairs, const std::vector<typ
         ++report.against;
     }
   }
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }
 

@@ -15,6 +15,7 @@
 #include <Normal_orientation/Winding_number_field.h>
 #include <Normal_orientation/internal/Parallel.h>
 #include <Normal_orientation/internal/Two_layer_fit.h>
+#include <Normal_orientation/internal/Unit_vector.h>
 
 #include <CGAL/number_utils.h>
 
@@ -57,42 +58,41 @@ Layer_pairs find_layer_pairs(const std::vector<Point>& points, const std::vector
   late.early_gap = 0.0;
   auto fit_points = [&](bool second) {
     parallel_chunks<ConcurrencyTag>(
-    n,
-    [&](std::size_t b, std::size_t e) {
-      std::vector<std::array<double, 3>> q;
-      std::vector<std::pair<double, std::uint32_t>> scratch;
-      auto to_array = [](const Point& p) {
-        return std::array<double, 3>{{CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())}};
-      };
-      for (std::size_t i = b; i < e; ++i) {
-        if (second && !again[i])
-          continue;
-        const double len = std::sqrt(CGAL::to_double(normals[i].squared_length()));
-        if (!(len > 0.0))
-          continue;
-        q.clear();
-        q.push_back(to_array(points[i]));
-        for_each_neighbor(i, [&](std::size_t j) { q.push_back(to_array(points[j])); });
-        const std::array<double, 3> u = {{CGAL::to_double(normals[i].x()) / len,
-                                          CGAL::to_double(normals[i].y()) / len,
-                                          CGAL::to_double(normals[i].z()) / len}};
-        fit[i] = fit_two_layers(q, u, scratch, second ? late : Two_layer_thresholds());
-      }
-    },
-    256);
+      n,
+      [&](std::size_t b, std::size_t e) {
+        std::vector<std::array<double, 3>> q;
+        std::vector<std::pair<double, std::uint32_t>> scratch;
+        auto to_array = [](const Point& p) {
+          return std::array<double, 3>{{CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())}};
+        };
+        for (std::size_t i = b; i < e; ++i) {
+          if (second && !again[i])
+            continue;
+          const std::array<double, 3> u = unit_vector(CGAL::to_double(normals[i].x()),
+                                                      CGAL::to_double(normals[i].y()),
+                                                      CGAL::to_double(normals[i].z()));
+          if (u == std::array<double, 3>{{0.0, 0.0, 0.0}})
+            continue;
+          q.clear();
+          q.push_back(to_array(points[i]));
+          for_each_neighbor(i, [&](std::size_t j) { q.push_back(to_array(points[j])); });
+          fit[i] = fit_two_layers(q, u, scratch, second ? late : Two_layer_thresholds());
+        }
+      },
+      256);
   };
   fit_points(false);
   again.assign(n, 0);
-  std::size_t count = 0;
+  bool any = false;
   for (std::size_t i = 0; i < n; ++i)
     if (fit[i].two_layers)
       for_each_neighbor(i, [&](std::size_t j) {
-        if (!fit[j].two_layers && !again[j]) {
+        if (!fit[j].two_layers) {
           again[j] = 1;
-          ++count;
+          any = true;
         }
       });
-  if (count > 0)
+  if (any)
     fit_points(true);
   Layer_pairs out;
   for (std::size_t i = 0; i < n; ++i)
@@ -139,7 +139,7 @@ inline std::vector<char> cue_components(const std::vector<double>& cue, const st
     const std::uint32_t c = component[i];
     if (vote[c] < 0.0)
       labels[i] = Label(-labels[i]);
-    fixed[i] = char(double(cued[c]) >= layer_cue_component_share * double(size[c]) && cued[c] > 0);
+    fixed[i] = char(double(cued[c]) >= layer_cue_component_share * double(size[c]));
   }
   return fixed;
 }

@@ -66,7 +66,6 @@ inline Two_layer_fit fit_two_layers(const std::vector<std::array<double, 3>>& q,
                                     const Two_layer_thresholds& t = Two_layer_thresholds())
 {
   Two_layer_fit out;
-  const double es = t.early_separation, eg = t.early_gap;
   const std::size_t m = q.size();
   if (m < 2 * t.min_side || t.min_side < 1)
     return out;
@@ -119,13 +118,13 @@ inline Two_layer_fit fit_two_layers(const std::vector<std::array<double, 3>>& q,
         lo = std::min(lo, scratch[k].first);
         hi = std::max(hi, scratch[k].first);
       }
-      const double min_gap = eg * std::sqrt(ss / double(m - 1));
+      const double min_gap = t.early_gap * std::sqrt(ss / double(m - 1));
       if (!(hi - lo > min_gap))
         return out;
       split_offsets();
       stats(0, split, mean_a, sd_a);
       stats(split, m, mean_b, sd_b);
-      if (!(mean_b - mean_a > std::max(min_gap, es * std::max(sd_a, sd_b))))
+      if (!(mean_b - mean_a > std::max(min_gap, t.early_separation * std::max(sd_a, sd_b))))
         return out;
     } else {
       split_offsets();
