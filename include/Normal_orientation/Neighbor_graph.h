@@ -9,6 +9,7 @@
 
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/internal/Clean_positions.h>
+#include <Normal_orientation/internal/Layer_edges.h>
 #include <Normal_orientation/internal/Parallel.h>
 
 #include <CGAL/Kd_tree.h>
@@ -75,6 +76,9 @@ struct Neighbor_graph_report
   /// every edge
   double konig_disagreement = std::numeric_limits<double>::quiet_NaN();
   bool konig_everywhere = false; ///< see `konig_disagreement`
+  /// the points whose k nearest neighbours lie on two layers, whose edges
+  /// across the gap are negated (see `build_neighbor_graph()`)
+  std::size_t number_of_two_layer_points = 0;
 };
 
 /// \ingroup PkgNormalOrientationGraph
@@ -242,7 +246,12 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
 /// \ingroup PkgNormalOrientationGraph
 /// Builds the neighbour graph of the paper (sec. 3): i and j are joined iff
 /// one is among the other's `k` nearest neighbours and |p_i - p_j| < r; the
-/// edge weight is w_ij = phi(i, j) * (1 - |p_i - p_j|^2 / r^2).
+/// edge weight is w_ij = phi(i, j) * (1 - |p_i - p_j|^2 / r^2), negated
+/// where the edge crosses the gap between two layers (the manual's *Layer
+/// edges*; unless `negate_across_layers` is false): where the k nearest
+/// neighbours of i (or j) closer than r lie on two parallel layers, both
+/// sides of a part thinner than the neighbour distance or two objects in
+/// contact, whose outward normals are opposite.
 ///
 /// \tparam ConcurrencyTag `CGAL::Parallel_tag` (kd-tree build, queries and
 ///         weights in parallel with TBB) or `CGAL::Sequential_tag`; the
@@ -265,6 +274,12 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
 /// \param progress receives progress in [0, 1] and may interrupt the run
 ///        (`Progress_reporter()` reports nothing; a reporter whose callback
 ///        returns `false` throws `Interrupted`)
+/// \param negate_across_layers whether the weights of the edges across two
+///        layers are negated
+/// \param layer_offsets if not null, receives per point the vector from it
+///        to the other layer's mean along the fitted normal line, zero where
+///        the point's neighbourhood is one layer (or with
+///        `negate_across_layers` false)
 /// \pre points and normals are finite (checked by `orient_normals()`)
 /// \return what was measured and decided: the k and r used, the number of edges, the times
 template <typename ConcurrencyTag, typename Kernel, typename FlipCriterion>
@@ -272,7 +287,9 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
                                            const std::vector<typename Kernel::Vector_3>& normals,
                                            unsigned int k, double radius, const FlipCriterion& criterion,
                                            Neighbor_graph& graph,
-                                           const Progress_reporter& progress = Progress_reporter())
+                                           const Progress_reporter& progress = Progress_reporter(),
+                                           bool negate_across_layers = true,
+                                           std::vector<std::array<float, 3>>* layer_offsets = nullptr)
 {
   if (points.size() != normals.size())
     throw std::invalid_argument("build_neighbor_graph: points and normals differ in size");
@@ -334,6 +351,35 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
         return false;
     return true;
   };
+  // The layer offsets of every point, from its own k nearest neighbours.
+  std::vector<internal::Layer_offset> layer;
+  if (negate_across_layers && k > 0)
+    internal::fit_layer_offsets<ConcurrencyTag>(
+      n,
+      [&](std::size_t i, double* p, double* u) {
+        internal::to_array(points[i], p);
+        internal::to_array(normals[i], u);
+      },
+      [&](std::size_t i, auto&& f) {
+        for (unsigned t = 0; t < k; ++t) {
+          const std::uint32_t j = nb[i * k + t];
+          if (double(d2[i * k + t]) < r2 && j != i) {
+            double x[3];
+            internal::to_array(points[j], x);
+            f(x);
+          }
+        }
+      },
+      [&](std::size_t i) {
+        for (unsigned t = 0; t < k; ++t)
+          if (double(d2[i * k + t]) < r2 && internal::is_two_layers(layer[nb[i * k + t]]))
+            return true;
+        return false;
+      },
+      layer);
+  for (const internal::Layer_offset& t : layer)
+    report.number_of_two_layer_points += internal::is_two_layers(t) ? 1 : 0;
+
   std::vector<std::uint32_t> count(n + 1, 0);
   std::vector<unsigned char> kept(n * k);
   internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
@@ -362,7 +408,15 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
         const double omega = 1.0 - double(d2[i * k + t]) / r2;
         sources[pos] = std::uint32_t(i);
         targets[pos] = j;
-        props[pos].weight = float(phi(points[i], normals[i], points[j], normals[j]) * omega);
+        double w = phi(points[i], normals[i], points[j], normals[j]) * omega;
+        if (!layer.empty() && (internal::is_two_layers(layer[i]) || internal::is_two_layers(layer[j]))) {
+          double p[3], q[3];
+          internal::to_array(points[i], p);
+          internal::to_array(points[j], q);
+          if (internal::edge_across_layers(p, layer[i], q, layer[j]))
+            w = -w;
+        }
+        props[pos].weight = float(w);
         ++pos;
       }
     }
@@ -373,6 +427,8 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
                    std::uint32_t(n));
   std::swap(graph, g);
   report.number_of_edges = m;
+  if (layer_offsets != nullptr)
+    layer_offsets->swap(layer);
   report.seconds_graph = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   progress.report(1.0);
   return report;

@@ -31,10 +31,12 @@ struct Global_sign_summary
   std::size_t seen_vetoes = 0;             ///< sheets (streamed: segments) where the winding number's flips against both the solver and visibility were undone
   std::size_t top_components_flipped = 0;  ///< components negated last because their top surface faced down (`top_side_flips()`)
   unsigned int rounds = 0;             ///< rounds of patch flips
-  /// layer cues (in core; 0 streamed): the points whose neighbourhood is two
-  /// layers closer than the neighbour distance (a thin part, or a contact)
+  /// the points whose k nearest neighbours lie on two layers closer than
+  /// the neighbour distance (a thin part, or a contact), whose edges across
+  /// the gap are negated (`build_neighbor_graph()`); set with or without
+  /// the stage
   std::size_t layer_pairs = 0;
-  std::size_t layer_cues = 0;          ///< of `layer_pairs`, those with a sure cue from the far field
+  std::size_t layer_cues = 0;          ///< of `layer_pairs`, those with a sure cue from the far field (in core; 0 streamed)
   std::size_t layer_cues_against = 0;  ///< of `layer_cues`, those whose sign the cue negated
   bool layer_cue_round = false;        ///< the solver and the stage ran again, with the cues as unary terms
   /// the fraction of the sampled area where w is within the tolerance of

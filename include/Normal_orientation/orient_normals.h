@@ -473,14 +473,17 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       const std::vector<std::uint32_t> order = internal::sort_spatially<ConcurrencyTag>(in);
       result.seconds.input = internal::seconds_since(t_start);
 
-      // 2. Graph.
+      // 2. Graph, with the edges across two layers negated.
       Neighbor_graph graph;
+      std::vector<internal::Layer_offset> layer_offsets;
       const Neighbor_graph_report gr =
         build_neighbor_graph<ConcurrencyTag, Kernel>(in.points, in.normals, settings.number_of_neighbors,
                                                      settings.neighbor_radius, criterion, graph,
-                                                     progress.part(Stage::GRAPH, 0.0, 0.8));
+                                                     progress.part(Stage::GRAPH, 0.0, 0.8), true, &layer_offsets);
       internal::add_graph_report(gr, result);
       const auto weight = get(&Neighbor_edge::weight, graph);
+      const internal::Layer_pairs layer_pairs = internal::core_layer_pairs(layer_offsets, graph, weight);
+      std::vector<internal::Layer_offset>().swap(layer_offsets);
       std::vector<Label> labels(n, Label(1));
       const auto label_map = CGAL::make_property_map(labels);
       result.energy_before = energy(graph, weight, label_map);
@@ -531,7 +534,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
           progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
           result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(
             graph, in.points, in.normals, component, gr.radius, has_unary, cued, cue_fixed, moved, global, labels,
-            want_cues && dense ? &cue_report : nullptr); // (no cues where noise hides the layers)
+            &layer_pairs, want_cues && dense ? &cue_report : nullptr); // (no cues where noise hides the layers)
           result.seconds.global += result.global.seconds;
         }
       };
@@ -565,11 +568,11 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
           want_cues = false;
           fine(solver, true, true); // (cues come only from the dense step: the pass did not run)
         }
-        result.global.layer_pairs = cue_report.pairs;
         result.global.layer_cues = cue_report.sure;
         result.global.layer_cues_against = cue_report.against;
         result.global.layer_cue_round = round;
       }
+      result.global.layer_pairs = layer_pairs.size();
       result.energy_after = energy(graph, weight, label_map);
       for (std::size_t q = 0; q < n; ++q)
         input_labels[order[q]] = labels[q];

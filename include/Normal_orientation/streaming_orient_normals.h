@@ -335,6 +335,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   } else {
     fine(solver, true, true);
   }
+  result.global.layer_pairs = swept.two_layer_points;
   edges.reset(); // removes the edge file
   if (global.orientation != Global_orientation::NONE && labels.point_flip)
     result.energy_after = std::numeric_limits<double>::quiet_NaN(); // (point by point: not measured)

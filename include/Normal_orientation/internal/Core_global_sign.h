@@ -404,8 +404,9 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
 /// seen; the winding number then negates patches, level by level, and its
 /// flips against both the solver and visibility are undone in the sheets
 /// they turn away from where they were seen (`seen_side_vetoes()`).
-/// Components with a point of `has_unary` keep their signs.  The layer
-/// cues' points (`cued`, per point, or empty) keep the signs of their
+/// Components with a point of `has_unary` keep their signs.  With
+/// `cues`, the layer cues of `pairs` (`core_layer_cues()`) after the
+/// stage's signs go to `cues`.  The layer cues' points (`cued`, per point, or empty) keep the signs of their
 /// sheets, segments and patches against their component, and the
 /// components with a point of `cue_fixed` (per point, or empty) keep theirs
 /// as a whole (`cue_components()`); no patch joins
@@ -418,7 +419,8 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
                                       const std::vector<char>& has_unary, const std::vector<char>& cued,
                                       const std::vector<char>& cue_fixed, const std::vector<char>& moved,
                                       const Global_settings& settings,
-                                      std::vector<Label>& labels, Layer_cue_report* cues = nullptr)
+                                      std::vector<Label>& labels, const Layer_pairs* pairs = nullptr,
+                                      Layer_cue_report* cues = nullptr)
 {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = points.size();
@@ -446,19 +448,21 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   std::vector<std::uint32_t> sample_sheet(ns);
   for (std::size_t t = 0; t < ns; ++t)
     sample_sheet[t] = sheet[samples.index[t]];
+  std::vector<char> sample_two_layers; // (per sample)
+  if (pairs && pairs->size() > 0) {
+    sample_two_layers.resize(ns);
+    for (std::size_t t = 0; t < ns; ++t)
+      sample_two_layers[t] = char(std::binary_search(pairs->point.begin(), pairs->point.end(), samples.index[t]));
+  }
   Seen_side_flips seen = seen_side_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
                                                          samples.component, sample_sheet, nc, number_of_sheets,
-                                                         component_fixed, settings, whole_fixed);
+                                                         component_fixed, settings, whole_fixed, sample_two_layers);
   std::vector<std::uint32_t> segment, sample_segment(ns);
   std::size_t number_of_segments = 0;
   std::vector<char> segment_flip;
-  Layer_pairs pairs; // (of the layer cues)
-  if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING || cues) {
+  if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING) {
     const Incidence inc(graph, get(&Neighbor_edge::weight, graph), "the global stage");
-    if (cues)
-      pairs = core_layer_pairs<ConcurrencyTag>(inc, points, normals);
-    if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING)
-      number_of_segments = labelling_segments(inc, labels, segment);
+    number_of_segments = labelling_segments(inc, labels, segment);
   }
   if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING) {
     for (std::size_t t = 0; t < ns; ++t)
@@ -525,11 +529,11 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
   // 5. The layer cues of the final signs.
-  if (cues) {
+  if (cues && pairs) {
     for (std::size_t t = 0; t < ns; ++t)
       if (top[samples.component[t]])
         samples.oriented[t] = -samples.oriented[t];
-    *cues = core_layer_cues<ConcurrencyTag, Kernel>(pairs, points, normals, labels, samples);
+    *cues = core_layer_cues<ConcurrencyTag, Kernel>(*pairs, points, normals, labels, samples);
   }
   report.visibility = settings.orientation == Global_orientation::VISIBILITY_AND_WINDING;
   report.seen_components_flipped = seen.components_flipped;

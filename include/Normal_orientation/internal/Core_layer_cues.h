@@ -5,15 +5,18 @@
 
 /// \file Core_layer_cues.h
 /// The layer cues (`Layer_cues.h`) on the in-core arrays, at the end of the
-/// global stage: the pairs from the neighbour graph's incidence lists, the
+/// global stage: the pairs from the layer offsets of the graph, the
 /// far field from the stage's samples with their final signs, and the cues
 /// as unary terms for one more solve.
 
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Winding_number_field.h>
-#include <Normal_orientation/internal/Graph_reduction.h>
+#include <Normal_orientation/Neighbor_graph.h>
+#include <Normal_orientation/internal/Layer_edges.h>
 #include <Normal_orientation/internal/Layer_cues.h>
+
+#include <boost/range/iterator_range.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -37,24 +40,34 @@ struct Layer_cue_report
   std::vector<double> unary;
 };
 
-/// The points of the in-core cloud whose neighbourhoods (over the incidence
-/// lists `inc` of the neighbour graph) are two layers, each with the total
-/// weight of its edges as its strength (a cue outweighs its point's edges).
-template <typename ConcurrencyTag, typename Point, typename Vector>
-Layer_pairs core_layer_pairs(const Incidence& inc, const std::vector<Point>& points,
-                             const std::vector<Vector>& normals)
+/// The points of the in-core cloud whose neighbourhoods are two layers,
+/// from their layer offsets (per point, `build_neighbor_graph()`), each with
+/// the total absolute weight of its edges in `graph` as its strength (a cue
+/// outweighs its point's edges).
+template <typename WeightMap>
+Layer_pairs core_layer_pairs(const std::vector<Layer_offset>& offsets, const Neighbor_graph& graph,
+                             const WeightMap& weight)
 {
-  Layer_pairs pairs = find_layer_pairs<ConcurrencyTag>(points, normals, [&](std::size_t i, auto&& f) {
-    for (std::uint32_t t = inc.first[i]; t < inc.first[i + 1]; ++t)
-      f(std::size_t(inc.other[t]));
-  });
+  Layer_pairs pairs;
+  std::vector<std::uint32_t> at(offsets.size(), ~std::uint32_t(0)); // point -> its pair
+  for (std::size_t i = 0; i < offsets.size(); ++i)
+    if (is_two_layers(offsets[i])) {
+      const Layer_offset& t = offsets[i];
+      at[i] = std::uint32_t(pairs.point.size());
+      pairs.point.push_back(std::uint32_t(i));
+      pairs.to_other.push_back({{double(t[0]), double(t[1]), double(t[2])}});
+      pairs.gap.push_back(std::sqrt(double(t[0]) * t[0] + double(t[1]) * t[1] + double(t[2]) * t[2]));
+    }
   pairs.strength.assign(pairs.size(), 0.0);
-  for (std::size_t t = 0; t < pairs.size(); ++t) {
-    const std::size_t i = pairs.point[t];
-    for (std::uint32_t e = inc.first[i]; e < inc.first[i + 1]; ++e)
-      pairs.strength[t] += std::abs(double(inc.weight[e]));
-    pairs.strength[t] = std::max(pairs.strength[t], 1e-3);
-  }
+  if (pairs.size() > 0)
+    for (const auto e : boost::make_iterator_range(edges(graph))) {
+      const double w = std::abs(double(get(weight, e)));
+      for (const std::uint32_t v : {std::uint32_t(source(e, graph)), std::uint32_t(target(e, graph))})
+        if (at[v] != ~std::uint32_t(0))
+          pairs.strength[at[v]] += w;
+    }
+  for (double& s : pairs.strength)
+    s = std::max(s, 1e-3);
   return pairs;
 }
 

@@ -13,9 +13,7 @@
 
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Winding_number_field.h>
-#include <Normal_orientation/internal/Parallel.h>
 #include <Normal_orientation/internal/Two_layer_fit.h>
-#include <Normal_orientation/internal/Unit_vector.h>
 
 #include <CGAL/number_utils.h>
 
@@ -30,7 +28,7 @@
 namespace Normal_orientation {
 namespace internal {
 
-/// The points whose neighbourhoods are two layers.
+/// The points whose neighbourhoods are two layers (`fit_two_layers()`).
 struct Layer_pairs
 {
   std::vector<std::uint32_t> point;               ///< the points, increasing
@@ -39,70 +37,6 @@ struct Layer_pairs
   std::vector<double> strength;                   ///< per point, the weight of its cue (set by the driver)
   std::size_t size() const { return point.size(); }
 };
-
-/// `fit_two_layers()` at every point with a non-zero normal, over the point
-/// and the neighbours that `for_each_neighbor(i, f)` passes to f(j), in
-/// parallel; the same for any number of threads.  The points where the
-/// early rejections of `Two_layer_thresholds` stop the fit are fitted again
-/// without them when a neighbour is two layers (a layer's edge, or a curved
-/// layer whose normal line is a few degrees off).
-template <typename ConcurrencyTag, typename Point, typename Vector, typename ForEachNeighbor>
-Layer_pairs find_layer_pairs(const std::vector<Point>& points, const std::vector<Vector>& normals,
-                             const ForEachNeighbor& for_each_neighbor)
-{
-  const std::size_t n = points.size();
-  std::vector<Two_layer_fit> fit(n);
-  std::vector<char> again; // (per point, in the second pass)
-  Two_layer_thresholds late;
-  late.early_separation = 0.0;
-  late.early_gap = 0.0;
-  auto fit_points = [&](bool second) {
-    parallel_chunks<ConcurrencyTag>(
-      n,
-      [&](std::size_t b, std::size_t e) {
-        std::vector<std::array<double, 3>> q;
-        std::vector<std::pair<double, std::uint32_t>> scratch;
-        auto to_array = [](const Point& p) {
-          return std::array<double, 3>{{CGAL::to_double(p.x()), CGAL::to_double(p.y()), CGAL::to_double(p.z())}};
-        };
-        for (std::size_t i = b; i < e; ++i) {
-          if (second && !again[i])
-            continue;
-          const std::array<double, 3> u = unit_vector(CGAL::to_double(normals[i].x()),
-                                                      CGAL::to_double(normals[i].y()),
-                                                      CGAL::to_double(normals[i].z()));
-          if (u == std::array<double, 3>{{0.0, 0.0, 0.0}})
-            continue;
-          q.clear();
-          q.push_back(to_array(points[i]));
-          for_each_neighbor(i, [&](std::size_t j) { q.push_back(to_array(points[j])); });
-          fit[i] = fit_two_layers(q, u, scratch, second ? late : Two_layer_thresholds());
-        }
-      },
-      256);
-  };
-  fit_points(false);
-  again.assign(n, 0);
-  bool any = false;
-  for (std::size_t i = 0; i < n; ++i)
-    if (fit[i].two_layers)
-      for_each_neighbor(i, [&](std::size_t j) {
-        if (!fit[j].two_layers) {
-          again[j] = 1;
-          any = true;
-        }
-      });
-  if (any)
-    fit_points(true);
-  Layer_pairs out;
-  for (std::size_t i = 0; i < n; ++i)
-    if (fit[i].two_layers) {
-      out.point.push_back(std::uint32_t(i));
-      out.to_other.push_back(fit[i].to_other);
-      out.gap.push_back(fit[i].gap);
-    }
-  return out;
-}
 
 /// The share of the points whose signs the sure cues must negate for the
 /// drivers to solve again with the cues as unary terms: a few cues at the

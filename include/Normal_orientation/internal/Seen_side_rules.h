@@ -65,13 +65,17 @@ struct Seen_side_flips
 /// (`exterior_visibility()` of the samples, with their oriented normals),
 /// then the patches of `sample_patch` that still do (those of the
 /// components of `fixed` left out); nothing unless `settings` asks for
-/// visibility.
+/// visibility.  The samples of `two_layers` (per sample, or empty) do not
+/// vote (their votes are 0): both layers lie within a splat's depth of each
+/// other, so either may be the first that a view meets; the patches where
+/// they hold most of the area keep their signs.
 template <typename ConcurrencyTag, typename Point, typename Vector>
 Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vector<Vector>& oriented,
                                 const std::vector<double>& areas, const std::vector<std::uint32_t>& sample_component,
                                 const std::vector<std::uint32_t>& sample_patch, std::size_t number_of_components,
                                 std::size_t number_of_patches, const std::vector<char>& fixed,
-                                const Global_settings& settings, const std::vector<char>& whole_fixed = {})
+                                const Global_settings& settings, const std::vector<char>& whole_fixed = {},
+                                const std::vector<char>& two_layers = {})
 {
   Seen_side_flips out;
   out.component.assign(number_of_components, 0);
@@ -83,6 +87,9 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
   for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
     free_component[c] = !fixed[c];
   out.vote = exterior_visibility<ConcurrencyTag>(points, oriented, areas, settings.visibility());
+  for (std::size_t j = 0; j < two_layers.size(); ++j)
+    if (two_layers[j])
+      out.vote[j] = 0.0;
   std::vector<double> vote = out.vote;
   std::vector<char> free_whole = free_component;
   for (std::size_t c = 0; c < whole_fixed.size() && c < number_of_components; ++c)
@@ -92,6 +99,16 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
     free_patch[sample_patch[j]] = free_component[sample_component[j]];
     if (out.component[sample_component[j]])
       vote[j] = -vote[j];
+  }
+  if (!two_layers.empty()) { // (a patch mostly on two layers keeps its sign)
+    std::vector<double> layered(number_of_patches, 0.0), total(number_of_patches, 0.0);
+    for (std::size_t j = 0; j < vote.size(); ++j) {
+      total[sample_patch[j]] += areas[j];
+      layered[sample_patch[j]] += two_layers[j] ? areas[j] : 0.0;
+    }
+    for (std::size_t P = 0; P < number_of_patches; ++P)
+      if (layered[P] > 0.5 * total[P])
+        free_patch[P] = 0;
   }
   out.patch = visibility_flips(vote, areas, sample_patch, free_patch);
   for (char f : out.component)

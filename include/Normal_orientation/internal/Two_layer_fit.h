@@ -42,6 +42,8 @@ struct Two_layer_thresholds
   unsigned int refits = 4;
   /// the fewest points on each side of the split
   std::size_t min_side = 3;
+  /// the fewest points in all (fewer, as with a small k, split by chance)
+  std::size_t min_points = 10;
   /// before any refit, the split along the point's own normal line is
   /// rejected when the layers' distance is under this times the larger
   /// spread (a single layer: most points stop here)
@@ -52,7 +54,7 @@ struct Two_layer_thresholds
   double early_gap = 0.07;
 };
 
-/// Whether the point `q[0]` and its neighbours `q[1..m-1]` (m >= 2 min_side)
+/// Whether the point `q[0]` and its neighbours `q[1..m-1]` (m >= 2 min_side, m >= min_points)
 /// lie on two parallel layers.  Their offsets along the normal line `normal`
 /// (unit) are split at their largest gap with at least `min_side` on each
 /// side; the line is refitted to both sides, each about its own mean (the
@@ -67,7 +69,7 @@ inline Two_layer_fit fit_two_layers(const std::vector<std::array<double, 3>>& q,
 {
   Two_layer_fit out;
   const std::size_t m = q.size();
-  if (m < 2 * t.min_side || t.min_side < 1)
+  if (m < std::max(2 * t.min_side, t.min_points) || t.min_side < 1)
     return out;
   std::array<double, 3> n = normal;
   std::size_t split = 0; // the first `split` of `scratch` (sorted) are the lower side

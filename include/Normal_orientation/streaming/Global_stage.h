@@ -46,6 +46,7 @@ struct Global_samples
   std::vector<std::uint32_t> segment;             ///< final segment
   std::vector<std::uint32_t> component;           ///< component
   std::vector<std::uint32_t> unit;                ///< patch unit (with `Patch_units`)
+  std::vector<char> two_layers;                   ///< on two layers (`Swept_record::two_layers`)
 };
 
 /// What the global stage needs to build its patches from units
@@ -99,6 +100,7 @@ Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std
       out.segment.push_back(points.segments()[q]);
       out.component.push_back(c);
       out.unit.push_back(unit);
+      out.two_layers.push_back(char(s.two_layers != 0));
     }
   }
   if (unit_file)
@@ -261,7 +263,7 @@ Stream_seen_sides stream_seen_sides(const Global_samples<Kernel>& samples, const
   }
   out.seen = Normal_orientation::internal::seen_side_flips<ConcurrencyTag>(
     samples.points, samples.normals, areas, samples.component, out.sheet, number_of_components,
-    out.number_of_sheets, component_fixed, settings);
+    out.number_of_sheets, component_fixed, settings, {}, samples.two_layers);
   std::vector<char> segment_flip(number_of_segments, 0);
   if (units && settings.orientation == Normal_orientation::Global_orientation::VISIBILITY_AND_WINDING) {
     segment_flip = Normal_orientation::internal::segment_tier_flips<ConcurrencyTag>(

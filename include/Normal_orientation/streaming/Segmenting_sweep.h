@@ -13,6 +13,7 @@
 #include <Normal_orientation/Point_record.h>
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Segmenter.h>
+#include <Normal_orientation/internal/Layer_edges.h>
 #include <Normal_orientation/internal/Parallel.h>
 #include <Normal_orientation/internal/Unit_vector.h>
 #include <Normal_orientation/streaming/Record_file.h>
@@ -32,12 +33,14 @@ namespace streaming {
 /// \cond SKIP_IN_MANUAL
 namespace internal {
 
-/// a point after the sweep: the record, its segment and its preliminary flip
+/// a point after the sweep: the record, its segment, its preliminary flip
+/// and whether its neighbourhood is two layers (`build_neighbor_graph()`)
 struct Swept_record
 {
   Point_record record;
   std::uint32_t segment;
-  std::int32_t flip;
+  std::int16_t flip;
+  std::uint16_t two_layers;
 };
 
 /// what the sweep keeps per point in its window
@@ -45,6 +48,8 @@ struct Sweep_payload
 {
   std::uint32_t segment = 0;
   Label flip = 1;
+  bool two_layers_first = false; ///< two layers after the first pass of `fit_layer_offsets()`
+  Normal_orientation::internal::Layer_offset layer{}; ///< the layer offset (`build_neighbor_graph()`)
 };
 
 /// unit normal of a record (zero when the normal is zero)
@@ -62,6 +67,7 @@ struct Sweep_stage_result
   std::uint64_t edge_span = 0;       ///< the farthest back an edge reaches
   std::uint64_t unary_terms = 0;     ///< points with a unary term
   double energy_before = 0.0;        ///< the energy of the input orientation, summed in the sweep order
+  std::uint64_t two_layer_points = 0; ///< points on two layers (`build_neighbor_graph()`)
 };
 
 /// The visitor of `sweep()` for the streaming driver.  `Unary` is callable
@@ -81,13 +87,43 @@ public:
       m_r2(radius * radius), m_progress(progress), m_n(n), m_out(out)
   {}
 
-  /// The edge weights of a whole batch, in parallel, with the input normals
-  /// (as in the in-core graph, in single precision); the neighbours'
-  /// preliminary flips are applied in `finalize`.
+  /// The layer offsets and the edge weights of a whole batch, in parallel,
+  /// with the input normals (as in the in-core graph, in single precision,
+  /// negated across two layers); the neighbours' preliminary flips are
+  /// applied in `finalize`.  The second pass of the fit sees the first
+  /// pass of the batch and of the earlier points (a later batch's is not
+  /// known yet).
   void prepare(Sweep_window<Sweep_payload>& w, std::uint64_t first, const std::vector<std::size_t>& offsets,
-               const std::vector<Sweep_neighbor>& neighbors)
+               const std::vector<Sweep_neighbor>& neighbors, const Sweep_batch_nearest& nearest)
   {
     m_progress.report(first, m_n); // `first` points are finalised
+    const std::size_t count = offsets.size() - 1;
+    Normal_orientation::internal::fit_layer_offsets<ConcurrencyTag>(
+      count,
+      [&](std::size_t q, double* p, double* u) {
+        const Point_record& r = w.record(first + q);
+        for (int d = 0; d < 3; ++d) {
+          p[d] = r.position[d];
+          u[d] = r.normal[d];
+        }
+      },
+      [&](std::size_t q, auto&& f) { nearest.for_each(q, [&](std::uint64_t j, float) { f(w.record(j).position); }); },
+      [&](std::size_t q) {
+        bool any = false;
+        nearest.for_each(q, [&](std::uint64_t j, float) {
+          if (j < first)
+            any = any || w.payload(j).two_layers_first;
+          else if (j < first + count)
+            any = any || Normal_orientation::internal::is_two_layers(m_layers[j - first]);
+        });
+        return any;
+      },
+      m_layers, &m_first_pass);
+    for (std::size_t q = 0; q < count; ++q) {
+      w.payload(first + q).layer = m_layers[q];
+      w.payload(first + q).two_layers_first = m_first_pass[q] != 0;
+      m_out.two_layer_points += Normal_orientation::internal::is_two_layers(m_layers[q]) ? 1 : 0;
+    }
     m_weights.resize(neighbors.size());
     m_cursor = 0;
     Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(offsets.size() - 1, [&](std::size_t b, std::size_t e) {
@@ -100,9 +136,13 @@ public:
           const Point_record& o = w.record(neighbors[t].sequence);
           const std::array<double, 3> no = unit_normal(o);
           const double omega = 1.0 - double(neighbors[t].squared_distance) / m_r2;
-          m_weights[t] = float(m_criterion(pp, vp, Point(o.position[0], o.position[1], o.position[2]),
-                                           Vector(no[0], no[1], no[2])) *
-                               omega);
+          double weight = m_criterion(pp, vp, Point(o.position[0], o.position[1], o.position[2]),
+                                      Vector(no[0], no[1], no[2])) *
+                          omega;
+          if (Normal_orientation::internal::edge_across_layers(p.position, w.payload(first + q).layer, o.position,
+                                                               w.payload(neighbors[t].sequence).layer))
+            weight = -weight;
+          m_weights[t] = float(weight);
         }
       }
     }, 256);
@@ -133,7 +173,8 @@ public:
     if (Unary::enabled && (record.normal[0] != 0.0 || record.normal[1] != 0.0 || record.normal[2] != 0.0))
       preference = m_unary(record);
     const Segment_assignment a = m_segmenter.add_point(m_votes, preference);
-    w.payload(s) = Sweep_payload{a.segment, a.flip};
+    w.payload(s).segment = a.segment;
+    w.payload(s).flip = a.flip;
     if (a.segment >= m_out.segment_size.size()) {
       m_out.segment_size.resize(a.segment + 1, 0);
       m_out.segment_has_unary.resize(a.segment + 1, 0);
@@ -148,7 +189,9 @@ public:
   /// writes point `s`, leaving the window, to the record file
   void release(Sweep_window<Sweep_payload>& w, std::uint64_t s)
   {
-    m_records.append(Swept_record{w.record(s), w.payload(s).segment, std::int32_t(w.payload(s).flip)});
+    const Sweep_payload& p = w.payload(s);
+    m_records.append(Swept_record{w.record(s), p.segment, std::int16_t(p.flip),
+                                  std::uint16_t(Normal_orientation::internal::is_two_layers(p.layer))});
   }
 
 private:
@@ -163,6 +206,8 @@ private:
   Sweep_stage_result& m_out;
   std::vector<Neighbor_vote> m_votes;
   std::vector<float> m_weights;
+  std::vector<Normal_orientation::internal::Layer_offset> m_layers;
+  std::vector<char> m_first_pass;
   std::size_t m_cursor = 0;
 };
 

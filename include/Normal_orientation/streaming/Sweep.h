@@ -84,6 +84,36 @@ struct Sweep_report
   double seconds_neighbors = 0.0;
 };
 
+/// \ingroup PkgNormalOrientationStreaming
+/// The k nearest neighbours closer than r that the queries of a batch found
+/// for its points, earlier and later ones alike (the point's own k nearest,
+/// as in core before the graph is made symmetric), for a visitor's
+/// `prepare`.
+class Sweep_batch_nearest
+{
+public:
+  /// calls f(sequence, squared_distance) for each of the k nearest
+  /// neighbours closer than r of point `first + q` of the batch
+  template <typename F>
+  void for_each(std::size_t q, const F& f) const
+  {
+    for (unsigned int t = 0; t < m_k; ++t) {
+      const std::uint32_t j = m_knn[q * m_k + t];
+      if (j != ~std::uint32_t(0) && double(m_d2[q * m_k + t]) < m_r2)
+        f(m_base + j, m_d2[q * m_k + t]);
+    }
+  }
+
+private:
+  template <typename C, typename K, typename S, typename F, typename V, typename P>
+  friend class Sweep;
+  const std::uint32_t* m_knn = nullptr;
+  const float* m_d2 = nullptr;
+  std::uint64_t m_base = 0;
+  unsigned int m_k = 0;
+  double m_r2 = 0.0;
+};
+
 template <typename ConcurrencyTag, typename Kernel, typename Source, typename KeyFunction, typename Visitor,
           typename Payload>
 class Sweep;
@@ -137,6 +167,17 @@ struct Has_prepare<Visitor, Window,
                      std::declval<Window&>(), std::uint64_t(0), std::declval<const std::vector<std::size_t>&>(),
                      std::declval<const std::vector<Sweep_neighbor>&>()))>> : std::true_type
 {};
+/// true when `Visitor` has `prepare(window, first, offsets, neighbors, nearest)`
+template <typename Visitor, typename Window, typename = void>
+struct Has_prepare_nearest : std::false_type
+{};
+template <typename Visitor, typename Window>
+struct Has_prepare_nearest<Visitor, Window,
+                           std::void_t<decltype(std::declval<Visitor&>().prepare(
+                             std::declval<Window&>(), std::uint64_t(0), std::declval<const std::vector<std::size_t>&>(),
+                             std::declval<const std::vector<Sweep_neighbor>&>(),
+                             std::declval<const Sweep_batch_nearest&>()))>> : std::true_type
+{};
 } // namespace internal
 /// \endcond
 
@@ -156,7 +197,9 @@ struct Has_prepare<Visitor, Window,
 /// finalised in batches; a visitor with a member `prepare(window, first,
 /// offsets, neighbors)` gets the whole batch first (point first + q has the
 /// neighbours `neighbors[offsets[q]] ... neighbors[offsets[q+1]-1]`), for
-/// work that can run in parallel, such as edge weights.  A point is
+/// work that can run in parallel, such as edge weights; with a member
+/// `prepare(window, first, offsets, neighbors, nearest)`, it also gets the
+/// points' own k nearest neighbours (`Sweep_batch_nearest`).  A point is
 /// released (`visitor.release(window, sequence)`, in order) once no point
 /// that may still need it remains to be finalised; then it leaves the
 /// window.  The window holds at most the points of a slab of thickness 3r
@@ -550,8 +593,17 @@ private:
     bucket_reverse_edges(job);
     build_earlier_lists(job);
     m_report.number_of_edges += m_batch_neighbors.size();
-    if constexpr (internal::Has_prepare<Visitor, Sweep_window<Payload>>::value)
+    if constexpr (internal::Has_prepare_nearest<Visitor, Sweep_window<Payload>>::value) {
+      Sweep_batch_nearest nearest;
+      nearest.m_knn = job.knn.data();
+      nearest.m_d2 = job.knn_d2.data();
+      nearest.m_base = job.base;
+      nearest.m_k = m_k;
+      nearest.m_r2 = m_r2;
+      m_visitor.prepare(m_window, job.first, m_batch_first, m_batch_neighbors, nearest);
+    } else if constexpr (internal::Has_prepare<Visitor, Sweep_window<Payload>>::value) {
       m_visitor.prepare(m_window, job.first, m_batch_first, m_batch_neighbors);
+    }
     for (std::size_t q = 0; q < count; ++q) {
       m_earlier.assign(m_batch_neighbors.begin() + std::ptrdiff_t(m_batch_first[q]),
                        m_batch_neighbors.begin() + std::ptrdiff_t(m_batch_first[q + 1]));
