@@ -135,17 +135,18 @@ TEST(Orient_normals, ThinSlabComesOutOutwardWithXie)
   EXPECT_EQ(orient_and_count(truth, cloud, pn_params().flip_criterion(NO::Xie_criterion())), 0u);
 }
 
-TEST(Orient_normals, ThinSlabDefeatsHoppe)
+TEST(Orient_normals, ThinSlabWithHoppe)
 {
-  // The same slab with Hoppe's criterion: edges across the slab ask the two
-  // sheets to agree, which is wrong.  This documents why Xie is needed there.
+  // The same slab with Hoppe's criterion and 30 neighbours: edges across the
+  // slab ask the two sheets to agree, which is wrong; the graph negates
+  // them where a point's neighbours lie on two layers (over 5% wrong before).
   std::mt19937_64 rng(5);
   const auto truth = box(24000, rng, 2.0, 2.0, 0.06);
   auto cloud = unoriented(truth, rng);
   // (without the global stage, which puts most of it right)
   const auto params = pn_params().number_of_neighbors(30).global_orientation(NO::Global_orientation::NONE);
   const auto wrong = orient_and_count(truth, cloud, params.flip_criterion(NO::Hoppe_criterion()));
-  EXPECT_GT(wrong, truth.size() / 20);
+  EXPECT_LT(wrong, truth.size() / 20);
   // the default takes König's curves on this small clean cloud, and they see the slab
   auto again = unoriented(truth, rng);
   EXPECT_LE(orient_and_count(truth, again, params), truth.size() / 100);
@@ -984,12 +985,11 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
                         // parts thinner than the neighbour distance, and
                         // flat contacts: the edges across the two layers are
                         // negated in both drivers (half the points wrong
-                        // before); the pipe, with fewer than 3 neighbours on
-                        // a layer at many points, keeps the most
-                        {"thin_plate", 0.01, 0.01},
-                        {"thin_pipe", 0.04, 0.08},
-                        {"thin_dome", 0.01, 0.01},
-                        {"touching_boxes", 0.015, 0.015}};
+                        // before; 2.5-5.9% on the pipe without the fill)
+                        {"thin_plate", 0.005, 0.005},
+                        {"thin_pipe", 0.01, 0.01},
+                        {"thin_dome", 0.005, 0.005},
+                        {"touching_boxes", 0.01, 0.01}};
   // Orients `input` streamed and in core: the wrong counts of both, and their reports.
   struct Both
   {

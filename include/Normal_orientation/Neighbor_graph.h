@@ -353,6 +353,7 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
   };
   // The layer offsets of every point, from its own k nearest neighbours.
   std::vector<internal::Layer_offset> layer;
+  std::vector<unsigned char> layer_state;
   if (negate_across_layers && k > 0)
     internal::fit_layer_offsets<ConcurrencyTag>(
       n,
@@ -361,22 +362,17 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
         internal::to_array(normals[i], u);
       },
       [&](std::size_t i, auto&& f) {
+        const internal::Layer_offset none{};
         for (unsigned t = 0; t < k; ++t) {
           const std::uint32_t j = nb[i * k + t];
           if (double(d2[i * k + t]) < r2 && j != i) {
             double x[3];
             internal::to_array(points[j], x);
-            f(x);
+            f(x, std::size_t(j), internal::ONE_LAYER, none);
           }
         }
       },
-      [&](std::size_t i) {
-        for (unsigned t = 0; t < k; ++t)
-          if (double(d2[i * k + t]) < r2 && internal::is_two_layers(layer[nb[i * k + t]]))
-            return true;
-        return false;
-      },
-      layer);
+      layer, layer_state);
   for (const internal::Layer_offset& t : layer)
     report.number_of_two_layer_points += internal::is_two_layers(t) ? 1 : 0;
 
@@ -410,10 +406,12 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
         targets[pos] = j;
         double w = phi(points[i], normals[i], points[j], normals[j]) * omega;
         if (!layer.empty() && (internal::is_two_layers(layer[i]) || internal::is_two_layers(layer[j]))) {
-          double p[3], q[3];
+          double p[3], q[3], np[3], nq[3];
           internal::to_array(points[i], p);
           internal::to_array(points[j], q);
-          if (internal::edge_across_layers(p, layer[i], q, layer[j]))
+          internal::to_array(normals[i], np);
+          internal::to_array(normals[j], nq);
+          if (internal::edge_across_layers(p, layer[i], np, q, layer[j], nq))
             w = -w;
         }
         props[pos].weight = float(w);

@@ -21,6 +21,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
@@ -47,26 +48,56 @@ void to_array(const PointOrVector& v, double* x)
 /// true when the neighbourhood of the point of offset `t` is two layers
 inline bool is_two_layers(const Layer_offset& t) { return t[0] != 0.f || t[1] != 0.f || t[2] != 0.f; }
 
-/// Fits the layer offsets of `count` points into `out` (resized), in
-/// parallel; the same for any number of threads.  `point_at(q, p, u)` writes
-/// the position and normal (any length; zero: no fit) of point q to the
-/// arrays p[3] and u[3]; `for_each_nearest(q, f)` calls f(x) with the
-/// position x (double[3]) of each of its k nearest neighbours closer than r
-/// (coincident positions count once).
-/// First pass: every point, with the early rejections of
-/// `Two_layer_thresholds`.  Second pass: without them, the points for which
-/// `nearest_two_layers(q)`, called after the first pass (`out` then holds its
-/// offsets), says that a nearest neighbour was two layers in the first pass
-/// (a layer's edge, or a curved layer whose normal line is a few degrees
-/// off).  `first_pass`, if not null, receives per point whether it was two
-/// layers after the first pass.
-template <typename ConcurrencyTag, typename PointAt, typename ForEachNearest, typename NearestTwoLayers>
+/// How a point's layer offset was found (`fit_layer_offsets()`).
+enum Layer_fit_state : unsigned char
+{
+  ONE_LAYER = 0,   ///< not two layers (or not known yet)
+  FIRST_PASS = 1,  ///< two layers in the first pass
+  SECOND_PASS = 2, ///< two layers in the second pass
+  FILLED = 3       ///< from a two-layer neighbour (the fill)
+};
+
+/// `for_each_nearest`'s index of a neighbour that is not among the points
+/// of the call
+constexpr std::size_t no_local = ~std::size_t(0);
+
+/// The offset that point `p` takes from its two-layer neighbour at `q`, of
+/// offset `t`: to the other layer of q when p lies on q's layer, back to
+/// q's layer when it lies beyond the middle of the gap.
+inline Layer_offset filled_offset(const double p[3], const double q[3], const Layer_offset& t)
+{
+  const double g = std::sqrt(double(t[0]) * t[0] + double(t[1]) * t[1] + double(t[2]) * t[2]);
+  const double u[3] = {t[0] / g, t[1] / g, t[2] / g};
+  const double s = (p[0] - q[0]) * u[0] + (p[1] - q[1]) * u[1] + (p[2] - q[2]) * u[2];
+  const double a = s < 0.5 * g ? g - s : -s;
+  return Layer_offset{{float(a * u[0]), float(a * u[1]), float(a * u[2])}};
+}
+
+/// Fits the layer offsets of `count` points into `out`, and their states
+/// into `state` (both resized), in parallel; the same for any number of
+/// threads.  `point_at(q, p, u)` writes the position and normal (any length;
+/// zero: no fit) of point q to the arrays p[3] and u[3];
+/// `for_each_nearest(q, f)` calls f(x, local, state, offset) for each of its
+/// k nearest neighbours closer than r: x its position (double[3]), local its
+/// index when it is one of the call's points, else `no_local`, with then its
+/// state and offset as far as the caller knows them (`ONE_LAYER` when not
+/// yet).  Coincident positions count once.
+/// 1. First pass: every point, with the early rejections of
+///    `Two_layer_thresholds`.
+/// 2. Second pass: without them, the points with a neighbour two layers in
+///    the first pass (a layer's edge, or a curved layer whose normal line is
+///    a few degrees off).
+/// 3. The fill: a point still on one layer, a quarter or more of whose
+///    neighbours are two layers after the passes, takes its offset from the
+///    nearest of them (`filled_offset()`; ties by position): where a layer
+///    has fewer than 3 of a point's neighbours, the fit misses it.
+template <typename ConcurrencyTag, typename PointAt, typename ForEachNearest>
 void fit_layer_offsets(std::size_t count, const PointAt& point_at, const ForEachNearest& for_each_nearest,
-                       const NearestTwoLayers& nearest_two_layers, std::vector<Layer_offset>& out,
-                       std::vector<char>* first_pass = nullptr)
+                       std::vector<Layer_offset>& out, std::vector<unsigned char>& state)
 {
   out.assign(count, Layer_offset{{0.f, 0.f, 0.f}});
-  std::vector<char> again;
+  state.assign(count, ONE_LAYER);
+  std::vector<char> again(count, 0);
   Two_layer_thresholds late;
   late.early_separation = 0.0;
   late.early_gap = 0.0;
@@ -86,33 +117,70 @@ void fit_layer_offsets(std::size_t count, const PointAt& point_at, const ForEach
             continue;
           q.clear();
           q.push_back({{p[0], p[1], p[2]}});
-          for_each_nearest(i, [&](const double* x) { // (coincident points count once)
+          for_each_nearest(i, [&](const double* x, std::size_t, unsigned char, const Layer_offset&) {
             const std::array<double, 3> a = {{x[0], x[1], x[2]}};
             if (std::find(q.begin(), q.end(), a) == q.end())
               q.push_back(a);
           });
           const Two_layer_fit f = fit_two_layers(q, u, scratch, second ? late : Two_layer_thresholds());
-          if (f.two_layers)
+          if (f.two_layers) {
             out[i] = Layer_offset{{float(f.to_other[0]), float(f.to_other[1]), float(f.to_other[2])}};
+            state[i] = second ? SECOND_PASS : FIRST_PASS;
+          }
         }
       },
       256);
   };
+  auto state_of = [&](std::size_t local, unsigned char external) { return local != no_local ? state[local] : external; };
   fit(false);
-  if (first_pass != nullptr) {
-    first_pass->assign(count, 0);
-    for (std::size_t i = 0; i < count; ++i)
-      (*first_pass)[i] = char(is_two_layers(out[i]));
-  }
-  again.assign(count, 0);
   bool any = false;
   for (std::size_t i = 0; i < count; ++i)
-    if (!is_two_layers(out[i]) && nearest_two_layers(i)) {
-      again[i] = 1;
-      any = true;
-    }
+    if (state[i] == ONE_LAYER)
+      for_each_nearest(i, [&](const double*, std::size_t local, unsigned char s, const Layer_offset&) {
+        if (state_of(local, s) == FIRST_PASS) {
+          again[i] = 1;
+          any = true;
+        }
+      });
   if (any)
     fit(true);
+  std::vector<Layer_offset> fill(count, Layer_offset{{0.f, 0.f, 0.f}});
+  parallel_chunks<ConcurrencyTag>(
+    count,
+    [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        if (state[i] != ONE_LAYER)
+          continue;
+        double p[3], n[3];
+        point_at(i, p, n);
+        std::size_t all = 0, layered = 0;
+        double best = HUGE_VAL;
+        std::array<double, 3> from{};
+        Layer_offset t{};
+        for_each_nearest(i, [&](const double* x, std::size_t local, unsigned char s, const Layer_offset& o) {
+          ++all;
+          const unsigned char st = state_of(local, s);
+          if (st != FIRST_PASS && st != SECOND_PASS)
+            return;
+          ++layered;
+          const double d = (x[0] - p[0]) * (x[0] - p[0]) + (x[1] - p[1]) * (x[1] - p[1]) + (x[2] - p[2]) * (x[2] - p[2]);
+          const std::array<double, 3> a = {{x[0], x[1], x[2]}};
+          if (d < best || (d == best && a < from)) {
+            best = d;
+            from = a;
+            t = local != no_local ? out[local] : o;
+          }
+        });
+        if (layered > 0 && 4 * layered >= all)
+          fill[i] = filled_offset(p, from.data(), t);
+      }
+    },
+    256);
+  for (std::size_t i = 0; i < count; ++i)
+    if (is_two_layers(fill[i])) {
+      out[i] = fill[i];
+      state[i] = FILLED;
+    }
 }
 
 /// Whether q lies on the other layer of the point p, whose layer offset is
@@ -126,11 +194,22 @@ inline bool across_layers(const double p[3], const double q[3], const Layer_offs
   return d > 0.5 * tt;
 }
 
-/// Whether the edge {p, q} crosses a gap between two layers, seen from
-/// either end: its weight is then negated.
-inline bool edge_across_layers(const double p[3], const Layer_offset& tp, const double q[3], const Layer_offset& tq)
+/// The smallest |cos| between the normal lines of an edge's ends for the
+/// edge to cross two layers: the layers are parallel, and the false fits at
+/// a sharp crease see the other face, at right angles.
+constexpr double layer_edge_min_alignment = 0.5;
+
+/// Whether the edge {p, q}, of normals np and nq (any length), crosses a
+/// gap between two layers, seen from either end, between nearly parallel
+/// normal lines: its weight is then negated.
+inline bool edge_across_layers(const double p[3], const Layer_offset& tp, const double np[3], const double q[3],
+                               const Layer_offset& tq, const double nq[3])
 {
-  return across_layers(p, q, tp) || across_layers(q, p, tq);
+  if (!across_layers(p, q, tp) && !across_layers(q, p, tq))
+    return false;
+  const double c = np[0] * nq[0] + np[1] * nq[1] + np[2] * nq[2];
+  const double a = np[0] * np[0] + np[1] * np[1] + np[2] * np[2], b = nq[0] * nq[0] + nq[1] * nq[1] + nq[2] * nq[2];
+  return c * c >= layer_edge_min_alignment * layer_edge_min_alignment * a * b && a > 0.0 && b > 0.0;
 }
 
 } // namespace internal

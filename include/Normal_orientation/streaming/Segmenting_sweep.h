@@ -48,7 +48,7 @@ struct Sweep_payload
 {
   std::uint32_t segment = 0;
   Label flip = 1;
-  bool two_layers_first = false; ///< two layers after the first pass of `fit_layer_offsets()`
+  unsigned char layer_state = 0; ///< how `layer` was found (`Layer_fit_state`)
   Normal_orientation::internal::Layer_offset layer{}; ///< the layer offset (`build_neighbor_graph()`)
 };
 
@@ -90,9 +90,8 @@ public:
   /// The layer offsets and the edge weights of a whole batch, in parallel,
   /// with the input normals (as in the in-core graph, in single precision,
   /// negated across two layers); the neighbours' preliminary flips are
-  /// applied in `finalize`.  The second pass of the fit sees the first
-  /// pass of the batch and of the earlier points (a later batch's is not
-  /// known yet).
+  /// applied in `finalize`.  The second pass and the fill of the fit see
+  /// the batch and the earlier points (a later batch's are not known yet).
   void prepare(Sweep_window<Sweep_payload>& w, std::uint64_t first, const std::vector<std::size_t>& offsets,
                const std::vector<Sweep_neighbor>& neighbors, const Sweep_batch_nearest& nearest)
   {
@@ -107,21 +106,22 @@ public:
           u[d] = r.normal[d];
         }
       },
-      [&](std::size_t q, auto&& f) { nearest.for_each(q, [&](std::uint64_t j, float) { f(w.record(j).position); }); },
-      [&](std::size_t q) {
-        bool any = false;
+      [&](std::size_t q, auto&& f) {
         nearest.for_each(q, [&](std::uint64_t j, float) {
-          if (j < first)
-            any = any || w.payload(j).two_layers_first;
-          else if (j < first + count)
-            any = any || Normal_orientation::internal::is_two_layers(m_layers[j - first]);
+          if (j >= first && j < first + count)
+            f(w.record(j).position, std::size_t(j - first), Normal_orientation::internal::ONE_LAYER, m_none);
+          else if (j < first)
+            f(w.record(j).position, Normal_orientation::internal::no_local, w.payload(j).layer_state,
+              w.payload(j).layer);
+          else // (a later batch's: not fitted yet)
+            f(w.record(j).position, Normal_orientation::internal::no_local, Normal_orientation::internal::ONE_LAYER,
+              m_none);
         });
-        return any;
       },
-      m_layers, &m_first_pass);
+      m_layers, m_states);
     for (std::size_t q = 0; q < count; ++q) {
       w.payload(first + q).layer = m_layers[q];
-      w.payload(first + q).two_layers_first = m_first_pass[q] != 0;
+      w.payload(first + q).layer_state = m_states[q];
       m_out.two_layer_points += Normal_orientation::internal::is_two_layers(m_layers[q]) ? 1 : 0;
     }
     m_weights.resize(neighbors.size());
@@ -139,8 +139,9 @@ public:
           double weight = m_criterion(pp, vp, Point(o.position[0], o.position[1], o.position[2]),
                                       Vector(no[0], no[1], no[2])) *
                           omega;
-          if (Normal_orientation::internal::edge_across_layers(p.position, w.payload(first + q).layer, o.position,
-                                                               w.payload(neighbors[t].sequence).layer))
+          if (Normal_orientation::internal::edge_across_layers(p.position, w.payload(first + q).layer, np.data(),
+                                                               o.position, w.payload(neighbors[t].sequence).layer,
+                                                               no.data()))
             weight = -weight;
           m_weights[t] = float(weight);
         }
@@ -207,7 +208,8 @@ private:
   std::vector<Neighbor_vote> m_votes;
   std::vector<float> m_weights;
   std::vector<Normal_orientation::internal::Layer_offset> m_layers;
-  std::vector<char> m_first_pass;
+  std::vector<unsigned char> m_states;
+  const Normal_orientation::internal::Layer_offset m_none{};
   std::size_t m_cursor = 0;
 };
 
