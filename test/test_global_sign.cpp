@@ -1058,6 +1058,47 @@ TEST(Two_layer_fit, TwoParallelLayersAndTheirGap)
   EXPECT_FALSE(NO::internal::fit_two_layers(q, {{0.0, 0.0, 1.0}}, scratch).two_layers);
 }
 
+TEST(Two_layer_fit, FacesAtACreaseAreNotTwoLayers)
+{
+  // Exact planes z = 0 (x < 0.05) and z = 0.2 (x - 0.05) meet at a crease;
+  // the point and 9 neighbours lie on the first, 4 on the second in a narrow
+  // band at x = 0.1, all at the same height over the first plane.  Side by
+  // side, they are one bent surface; moved over the first face at the same
+  // height, they are a second layer.
+  std::mt19937_64 rng(5);
+  std::vector<std::array<double, 3>> q = {{0.0, 0.0, 0.0}};
+  for (int k = 0; k < 9; ++k)
+    q.push_back({NO::hard_shapes::internal::uniform(rng, -0.1, 0.05), NO::hard_shapes::internal::uniform(rng, -0.1, 0.1), 0.0});
+  const double height = 0.2 * (0.1 - 0.05);
+  for (int k = 0; k < 4; ++k)
+    q.push_back({0.1, NO::hard_shapes::internal::uniform(rng, -0.1, 0.1), height});
+  std::vector<std::pair<double, std::uint32_t>> scratch;
+  EXPECT_FALSE(NO::internal::fit_two_layers(q, {{0.0, 0.0, 1.0}}, scratch).two_layers);
+  for (std::size_t k = 10; k < q.size(); ++k)
+    q[k][0] = NO::hard_shapes::internal::uniform(rng, -0.1, 0.05);
+  const NO::internal::Two_layer_fit f = NO::internal::fit_two_layers(q, {{0.0, 0.0, 1.0}}, scratch);
+  ASSERT_TRUE(f.two_layers);
+  EXPECT_NEAR(f.gap, height, 1e-9);
+}
+
+TEST(Two_layer_fit, ALayerMustStepNotClimb)
+{
+  // The point and 9 neighbours on z = 0 within 0.05 of it; 3 more at height
+  // 0.006 all around, 0.1 away (the faces around a mesh vertex bending up):
+  // the surface climbs 0.006 over 0.05, one layer.  The same 3 under the
+  // point, 0.02 away, step 0.006 at once: two layers.
+  for (const double radius : {0.1, 0.02}) {
+    std::vector<std::array<double, 3>> q = {{0.0, 0.0, 0.0}};
+    for (int k = 0; k < 9; ++k)
+      q.push_back({0.05 * std::cos(0.7 * k + 0.2), 0.05 * std::sin(0.7 * k + 0.2), 0.0});
+    for (int k = 0; k < 3; ++k)
+      q.push_back({radius * std::cos(2.1 * k), radius * std::sin(2.1 * k), 0.006});
+    std::vector<std::pair<double, std::uint32_t>> scratch;
+    const NO::internal::Two_layer_fit f = NO::internal::fit_two_layers(q, {{0.0, 0.0, 1.0}}, scratch);
+    EXPECT_EQ(f.two_layers, radius < 0.05) << radius;
+  }
+}
+
 TEST(Layer_edges, NegatedAcrossTwoLayersOnly)
 {
   // Two jittered grids of spacing 1 at z = 0 and z = 0.3 with the same

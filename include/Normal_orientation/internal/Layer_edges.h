@@ -97,10 +97,15 @@ void fit_layer_offsets(std::size_t count, const PointAt& point_at, const ForEach
 {
   out.assign(count, Layer_offset{{0.f, 0.f, 0.f}});
   state.assign(count, ONE_LAYER);
+  // again[i]: 1 when a neighbour of i is two layers in the first pass, 2
+  // when one is two layers in any way (set in the first pass for the
+  // neighbours that are not the call's points, whose states are known)
   std::vector<char> again(count, 0);
   Two_layer_thresholds late;
   late.early_separation = 0.0;
   late.early_gap = 0.0;
+  late.early_side_by_side = false;
+  late.early_detilt = false;
   auto fit = [&](bool second) {
     parallel_chunks<ConcurrencyTag>(
       count,
@@ -108,20 +113,26 @@ void fit_layer_offsets(std::size_t count, const PointAt& point_at, const ForEach
         std::vector<std::array<double, 3>> q;
         std::vector<std::pair<double, std::uint32_t>> scratch;
         for (std::size_t i = b; i < e; ++i) {
-          if (second && !again[i])
+          if (second && (again[i] != 1 || state[i] != ONE_LAYER))
             continue;
           double p[3], n[3];
           point_at(i, p, n);
           const std::array<double, 3> u = unit_vector(n[0], n[1], n[2]);
-          if (u == std::array<double, 3>{{0.0, 0.0, 0.0}})
-            continue;
           q.clear();
           q.push_back({{p[0], p[1], p[2]}});
-          for_each_nearest(i, [&](const double* x, std::size_t, unsigned char, const Layer_offset&) {
-            const std::array<double, 3> a = {{x[0], x[1], x[2]}};
-            if (std::find(q.begin(), q.end(), a) == q.end())
-              q.push_back(a);
+          for_each_nearest(i, [&](const double* x, std::size_t local, unsigned char s, const Layer_offset&) {
+            if (!second && local == no_local && s != ONE_LAYER)
+              again[i] = std::max(again[i], char(s == FIRST_PASS ? 1 : s == SECOND_PASS ? 2 : 0));
+            q.push_back({{x[0], x[1], x[2]}});
           });
+          // coincident positions once (after the gather, whose loads overlap)
+          std::size_t kept = 1;
+          for (std::size_t j = 1; j < q.size(); ++j)
+            if (std::find(q.begin(), q.begin() + kept, q[j]) == q.begin() + kept)
+              q[kept++] = q[j];
+          q.resize(kept);
+          if (u == std::array<double, 3>{{0.0, 0.0, 0.0}})
+            continue;
           const Two_layer_fit f = fit_two_layers(q, u, scratch, second ? late : Two_layer_thresholds());
           if (f.two_layers) {
             out[i] = Layer_offset{{float(f.to_other[0]), float(f.to_other[1]), float(f.to_other[2])}};
@@ -133,17 +144,25 @@ void fit_layer_offsets(std::size_t count, const PointAt& point_at, const ForEach
   };
   auto state_of = [&](std::size_t local, unsigned char external) { return local != no_local ? state[local] : external; };
   fit(false);
-  bool any = false;
-  for (std::size_t i = 0; i < count; ++i)
-    if (state[i] == ONE_LAYER)
-      for_each_nearest(i, [&](const double*, std::size_t local, unsigned char s, const Layer_offset&) {
-        if (state_of(local, s) == FIRST_PASS) {
-          again[i] = 1;
-          any = true;
-        }
-      });
-  if (any)
+  const bool first_pass_fits = std::find(state.begin(), state.end(), FIRST_PASS) != state.end();
+  if (first_pass_fits)
+    parallel_chunks<ConcurrencyTag>(
+      count,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i)
+          if (state[i] == ONE_LAYER && again[i] != 1)
+            for_each_nearest(i, [&](const double*, std::size_t local, unsigned char, const Layer_offset&) {
+              if (local != no_local && state[local] == FIRST_PASS)
+                again[i] = 1;
+            });
+      },
+      256);
+  if (std::find(again.begin(), again.end(), char(1)) != again.end())
     fit(true);
+  // the fill, where a neighbour is two layers
+  if (std::find_if(state.begin(), state.end(), [](unsigned char c) { return c != ONE_LAYER; }) == state.end() &&
+      std::find_if(again.begin(), again.end(), [](char a) { return a != 0; }) == again.end())
+    return;
   std::vector<Layer_offset> fill(count, Layer_offset{{0.f, 0.f, 0.f}});
   parallel_chunks<ConcurrencyTag>(
     count,

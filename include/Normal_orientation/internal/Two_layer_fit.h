@@ -36,6 +36,10 @@ struct Two_layer_thresholds
   /// the layers' distance must exceed this times the larger spread about
   /// their own means
   double separation = 20.0;
+  /// the layers' distance must exceed this times the smallest distance,
+  /// across the fitted line, between two points on different layers (one
+  /// surface that bends climbs less between neighbouring points)
+  double min_step = 0.2;
   /// the fitted line must be within acos(this) of the point's normal line
   double min_alignment = 0.7;
   /// refits of the line to both layers, each about its own mean
@@ -52,7 +56,118 @@ struct Two_layer_thresholds
   /// is under this times the root-mean-square distance of the neighbours
   /// from the point (the offsets of one curved layer are far smaller)
   double early_gap = 0.07;
+  /// before any refit, the split is also rejected when its sides lie side
+  /// by side (`side_by_side()`): one surface seen along a tilted line
+  bool early_side_by_side = true;
+  /// before any sort, the neighbourhood is also rejected when its offsets,
+  /// less the plane that fits them best over the tangential position
+  /// (`detilted_range()`), range over no more than `early_gap` times that
+  /// root-mean-square distance: one layer seen along a tilted normal line
+  bool early_detilt = true;
 };
+
+/// The range of the offsets of q[0..m) along the unit line `n`, from q[0],
+/// less the least-squares affine function of their position across n.
+inline double detilted_range(const std::vector<std::array<double, 3>>& q, const std::array<double, 3>& n)
+{
+  // a basis of the plane normal to n
+  const int axis = std::abs(n[0]) < std::abs(n[1]) ? (std::abs(n[0]) < std::abs(n[2]) ? 0 : 2)
+                                                   : (std::abs(n[1]) < std::abs(n[2]) ? 1 : 2);
+  std::array<double, 3> e1 = {{0.0, 0.0, 0.0}};
+  e1[axis] = 1.0;
+  const double c = e1[0] * n[0] + e1[1] * n[1] + e1[2] * n[2];
+  for (int d = 0; d < 3; ++d)
+    e1[d] -= c * n[d];
+  const double l = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  for (int d = 0; d < 3; ++d)
+    e1[d] /= l;
+  const std::array<double, 3> e2 = {{n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]}};
+  const std::size_t m = q.size();
+  double sx = 0.0, sy = 0.0, so = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0, sxo = 0.0, syo = 0.0;
+  auto coordinates = [&](std::size_t k, double& x, double& y, double& o) {
+    const double v[3] = {q[k][0] - q[0][0], q[k][1] - q[0][1], q[k][2] - q[0][2]};
+    x = v[0] * e1[0] + v[1] * e1[1] + v[2] * e1[2];
+    y = v[0] * e2[0] + v[1] * e2[1] + v[2] * e2[2];
+    o = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+  };
+  for (std::size_t k = 0; k < m; ++k) {
+    double x, y, o;
+    coordinates(k, x, y, o);
+    sx += x; sy += y; so += o;
+    sxx += x * x; sxy += x * y; syy += y * y; sxo += x * o; syo += y * o;
+  }
+  const double w = 1.0 / double(m);
+  sxx -= sx * sx * w; sxy -= sx * sy * w; syy -= sy * sy * w; sxo -= sx * so * w; syo -= sy * so * w;
+  const double det = sxx * syy - sxy * sxy;
+  double a = 0.0, b = 0.0;
+  if (det > 1e-12 * (sxx * syy) && det > 0.0) {
+    a = (sxo * syy - syo * sxy) / det;
+    b = (syo * sxx - sxo * sxy) / det;
+  }
+  double lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (std::size_t k = 0; k < m; ++k) {
+    double x, y, o;
+    coordinates(k, x, y, o);
+    const double r = o - a * x - b * y;
+    lo = std::min(lo, r);
+    hi = std::max(hi, r);
+  }
+  return hi - lo;
+}
+
+/// Whether the sides of a split lie side by side rather than over each
+/// other: projected on the plane normal to `n`, no point of the lower side
+/// (`scratch[0, split)`) lies beyond the nearest point of the upper side
+/// along the direction between their centroids.  Two faces meeting at a
+/// slight crease split so (exact planes leave each side no spread along
+/// the fitted line); two layers overlap.
+inline bool side_by_side(const std::vector<std::array<double, 3>>& q,
+                         const std::vector<std::pair<double, std::uint32_t>>& scratch, std::size_t split,
+                         const std::array<double, 3>& n)
+{
+  const std::size_t m = scratch.size();
+  auto tangential = [&](std::size_t s) {
+    const auto& p = q[scratch[s].second];
+    const double v[3] = {p[0] - q[0][0], p[1] - q[0][1], p[2] - q[0][2]};
+    const double o = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+    return std::array<double, 3>{{v[0] - o * n[0], v[1] - o * n[1], v[2] - o * n[2]}};
+  };
+  std::array<double, 3> d = {{0.0, 0.0, 0.0}}; // from the lower side's centroid to the upper's
+  for (std::size_t s = 0; s < m; ++s) {
+    const std::array<double, 3> v = tangential(s);
+    const double w = s < split ? -1.0 / double(split) : 1.0 / double(m - split);
+    for (int c = 0; c < 3; ++c)
+      d[c] += w * v[c];
+  }
+  double lower = -HUGE_VAL, upper = HUGE_VAL;
+  for (std::size_t s = 0; s < m; ++s) {
+    const std::array<double, 3> v = tangential(s);
+    const double x = v[0] * d[0] + v[1] * d[1] + v[2] * d[2];
+    if (s < split)
+      lower = std::max(lower, x);
+    else
+      upper = std::min(upper, x);
+  }
+  return lower < upper;
+}
+
+/// The smallest distance, across the line `n`, between a point of the lower
+/// side of a split (`scratch[0, split)`) and one of the upper side.
+inline double closest_across(const std::vector<std::array<double, 3>>& q,
+                             const std::vector<std::pair<double, std::uint32_t>>& scratch, std::size_t split,
+                             const std::array<double, 3>& n)
+{
+  double best = HUGE_VAL;
+  for (std::size_t a = 0; a < split; ++a)
+    for (std::size_t b = split; b < scratch.size(); ++b) {
+      const auto& p = q[scratch[a].second];
+      const auto& r = q[scratch[b].second];
+      const double v[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+      const double o = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+      best = std::min(best, v[0] * v[0] + v[1] * v[1] + v[2] * v[2] - o * o);
+    }
+  return std::sqrt(std::max(best, 0.0));
+}
 
 /// Whether the point `q[0]` and its neighbours `q[1..m-1]` (m >= 2 min_side, m >= min_points)
 /// lie on two parallel layers.  Their offsets along the normal line `normal`
@@ -61,8 +176,11 @@ struct Two_layer_thresholds
 /// smallest eigenvector of the sum of their scatter matrices), `refits`
 /// times, and split again.  Two layers when the distance between the sides'
 /// means along the line exceeds `separation` times the larger of their
-/// standard deviations about them, and the line is within acos(`min_alignment`)
-/// of `normal`.  Deterministic; `scratch` is reused between calls.
+/// standard deviations about them, the line is within acos(`min_alignment`)
+/// of `normal`, the sides are not side by side (`side_by_side()`), and the
+/// distance exceeds `min_step` times the closest distance across the line
+/// between points of different sides (`closest_across()`).
+/// Deterministic; `scratch` is reused between calls.
 inline Two_layer_fit fit_two_layers(const std::vector<std::array<double, 3>>& q, const std::array<double, 3>& normal,
                                     std::vector<std::pair<double, std::uint32_t>>& scratch,
                                     const Two_layer_thresholds& t = Two_layer_thresholds())
@@ -121,12 +239,14 @@ inline Two_layer_fit fit_two_layers(const std::vector<std::array<double, 3>>& q,
         hi = std::max(hi, scratch[k].first);
       }
       const double min_gap = t.early_gap * std::sqrt(ss / double(m - 1));
-      if (!(hi - lo > min_gap))
+      if (!(hi - lo > min_gap) || (t.early_detilt && !(detilted_range(q, n) > min_gap)))
         return out;
       split_offsets();
       stats(0, split, mean_a, sd_a);
       stats(split, m, mean_b, sd_b);
       if (!(mean_b - mean_a > std::max(min_gap, t.early_separation * std::max(sd_a, sd_b))))
+        return out;
+      if (t.early_side_by_side && side_by_side(q, scratch, split, n))
         return out;
     } else {
       split_offsets();
@@ -159,6 +279,8 @@ inline Two_layer_fit fit_two_layers(const std::vector<std::array<double, 3>>& q,
   const double gap = mean_b - mean_a;
   const double alignment = std::abs(n[0] * normal[0] + n[1] * normal[1] + n[2] * normal[2]);
   if (!(gap > t.separation * std::max(sd_a, sd_b)) || alignment < t.min_alignment)
+    return out;
+  if (side_by_side(q, scratch, split, n) || !(gap > t.min_step * closest_across(q, scratch, split, n)))
     return out;
   bool own_in_a = false; // (the point's own offset is 0)
   for (std::size_t s = 0; s < split; ++s)

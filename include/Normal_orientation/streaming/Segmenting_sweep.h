@@ -120,13 +120,17 @@ public:
       },
       m_layers, m_states);
     for (std::size_t q = 0; q < count; ++q) {
-      w.payload(first + q).layer = m_layers[q];
-      w.payload(first + q).layer_state = m_states[q];
-      m_out.two_layer_points += Normal_orientation::internal::is_two_layers(m_layers[q]) ? 1 : 0;
+      Sweep_payload& payload = w.payload(first + q);
+      payload.layer = m_layers[q];
+      payload.layer_state = m_states[q];
+      const bool two = Normal_orientation::internal::is_two_layers(m_layers[q]);
+      m_out.two_layer_points += two ? 1 : 0;
+      m_window_two_layers += two ? 1 : 0;
     }
+    const bool any_two_layers = m_window_two_layers > 0; // (else no edge of the batch crosses layers)
     m_weights.resize(neighbors.size());
     m_cursor = 0;
-    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(offsets.size() - 1, [&](std::size_t b, std::size_t e) {
+    Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
       for (std::size_t q = b; q < e; ++q) {
         const Point_record& p = w.record(first + q);
         const std::array<double, 3> np = unit_normal(p);
@@ -139,7 +143,7 @@ public:
           double weight = m_criterion(pp, vp, Point(o.position[0], o.position[1], o.position[2]),
                                       Vector(no[0], no[1], no[2])) *
                           omega;
-          if (Normal_orientation::internal::edge_across_layers(p.position, w.payload(first + q).layer, np.data(),
+          if (any_two_layers && Normal_orientation::internal::edge_across_layers(p.position, w.payload(first + q).layer, np.data(),
                                                                o.position, w.payload(neighbors[t].sequence).layer,
                                                                no.data()))
             weight = -weight;
@@ -191,6 +195,7 @@ public:
   void release(Sweep_window<Sweep_payload>& w, std::uint64_t s)
   {
     const Sweep_payload& p = w.payload(s);
+    m_window_two_layers -= Normal_orientation::internal::is_two_layers(p.layer) ? 1 : 0;
     m_records.append(Swept_record{w.record(s), p.segment, std::int16_t(p.flip),
                                   std::uint16_t(Normal_orientation::internal::is_two_layers(p.layer))});
   }
@@ -210,6 +215,7 @@ private:
   std::vector<Normal_orientation::internal::Layer_offset> m_layers;
   std::vector<unsigned char> m_states;
   const Normal_orientation::internal::Layer_offset m_none{};
+  std::uint64_t m_window_two_layers = 0; // two-layer points in the window
   std::size_t m_cursor = 0;
 };
 
