@@ -31,7 +31,6 @@ namespace internal {
 /// What the layer cues saw, and their unary terms.
 struct Layer_cue_report
 {
-  std::size_t pairs = 0;     ///< points whose neighbourhood is two layers
   std::size_t sure = 0;      ///< of them, with a sure cue
   std::size_t against = 0;   ///< of them, whose label the cue negates
   /// per point, the cue's label times the total weight of the point's edges
@@ -80,7 +79,6 @@ Layer_cue_report core_layer_cues(const Layer_pairs& pairs, const std::vector<typ
                                  const std::vector<Label>& labels, const Samples& samples)
 {
   Layer_cue_report report;
-  report.pairs = pairs.size();
   if (pairs.size() > 0 && !samples.points.empty()) {
     Winding_number_field<Kernel> field;
     field.template build<ConcurrencyTag>(samples.points, samples.oriented, samples.areas);
