@@ -9,6 +9,7 @@
 
 #include <Normal_orientation/Neighbor_graph.h>
 #include <Normal_orientation/Progress.h>
+#include <Normal_orientation/internal/Unit_vector.h>
 #include <Normal_orientation/internal/Winding_number_tree.h>
 
 #include <CGAL/Kernel_traits.h>
@@ -178,17 +179,8 @@ std::vector<double> estimate_point_areas(const std::vector<Point>& points, const
       const double inv = 1.0 / std::sqrt(len2);
       for (double& c : nv)
         c *= inv;
-      // an orthonormal basis (u, v) of the tangent plane
-      double u[3];
-      if (std::abs(nv[0]) < 0.6) {
-        u[0] = 0.0; u[1] = nv[2]; u[2] = -nv[1]; // e_x x n
-      } else {
-        u[0] = -nv[2]; u[1] = 0.0; u[2] = nv[0]; // e_y x n
-      }
-      const double ul = 1.0 / std::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
-      for (double& c : u)
-        c *= ul;
-      const double v[3] = {nv[1] * u[2] - nv[2] * u[1], nv[2] * u[0] - nv[0] * u[2], nv[0] * u[1] - nv[1] * u[0]};
+      double u[3], v[3]; // an orthonormal basis of the tangent plane
+      internal::tangent_basis(nv, u, v);
       unsigned int m = 0, same = 0;
       for (unsigned int t = 0; t < k; ++t) {
         const Point& q = points[nb[s * k + t]];

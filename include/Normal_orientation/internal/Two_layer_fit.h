@@ -10,6 +10,7 @@
 /// positions of the point and its neighbours and the point's normal line.
 
 #include <Normal_orientation/internal/Symmetric_eigen_3.h>
+#include <Normal_orientation/internal/Unit_vector.h>
 
 #include <algorithm>
 #include <array>
@@ -70,18 +71,8 @@ struct Two_layer_thresholds
 /// less the least-squares affine function of their position across n.
 inline double detilted_range(const std::vector<std::array<double, 3>>& q, const std::array<double, 3>& n)
 {
-  // a basis of the plane normal to n
-  const int axis = std::abs(n[0]) < std::abs(n[1]) ? (std::abs(n[0]) < std::abs(n[2]) ? 0 : 2)
-                                                   : (std::abs(n[1]) < std::abs(n[2]) ? 1 : 2);
-  std::array<double, 3> e1 = {{0.0, 0.0, 0.0}};
-  e1[axis] = 1.0;
-  const double c = e1[0] * n[0] + e1[1] * n[1] + e1[2] * n[2];
-  for (int d = 0; d < 3; ++d)
-    e1[d] -= c * n[d];
-  const double l = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
-  for (int d = 0; d < 3; ++d)
-    e1[d] /= l;
-  const std::array<double, 3> e2 = {{n[1] * e1[2] - n[2] * e1[1], n[2] * e1[0] - n[0] * e1[2], n[0] * e1[1] - n[1] * e1[0]}};
+  double e1[3], e2[3]; // a basis of the plane normal to n
+  tangent_basis(n.data(), e1, e2);
   const std::size_t m = q.size();
   double sx = 0.0, sy = 0.0, so = 0.0, sxx = 0.0, sxy = 0.0, syy = 0.0, sxo = 0.0, syo = 0.0;
   auto coordinates = [&](std::size_t k, double& x, double& y, double& o) {

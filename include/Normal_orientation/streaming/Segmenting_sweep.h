@@ -143,7 +143,8 @@ public:
           double weight = m_criterion(pp, vp, Point(o.position[0], o.position[1], o.position[2]),
                                       Vector(no[0], no[1], no[2])) *
                           omega;
-          if (any_two_layers && Normal_orientation::internal::edge_across_layers(p.position, w.payload(first + q).layer, np.data(),
+          if (any_two_layers &&
+              Normal_orientation::internal::edge_across_layers(p.position, w.payload(first + q).layer, np.data(),
                                                                o.position, w.payload(neighbors[t].sequence).layer,
                                                                no.data()))
             weight = -weight;
