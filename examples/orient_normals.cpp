@@ -189,7 +189,8 @@ NO::Orientation_result orient_in_core(Range& range, const Np& np, const Cli::Opt
                             .solver(solver)
                             .component_sign(Cli::Component_sign(o))
                             .global_orientation(Cli::global_orientation(o))
-                            .up_direction(o.up);
+                            .up_direction(o.up)
+                            .layer_edges(o.layer_edges);
     if (!prior.empty())
       return NO::orient_normals(range, policies.orientation_prior_map(CGAL::make_property_map(prior)));
     return NO::orient_normals(range, policies);
@@ -317,7 +318,8 @@ Cli::Streamed_run orient_streamed(const Cli::Options& o, Cli::Progress_bar& bar)
                             .solver(solver)
                             .component_sign(Cli::Component_sign(o))
                             .global_orientation(Cli::global_orientation(o))
-                            .up_direction(o.up);
+                            .up_direction(o.up)
+                            .layer_edges(o.layer_edges);
     if (o.prior_weight > 0.0)
       return orient(policies.orientation_prior_map(
         Cli::Record_viewpoint_prior{{{o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]}}, o.prior_weight}));

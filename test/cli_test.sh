@@ -383,6 +383,28 @@ expect_exit 0 "--stream: global stage in the json" "$prog" --quiet --json --stre
 check "streamed json has a global object" grep -q '"global": {"stage": "visibility"' "$dir/out.txt"
 expect_exit 0 "--stream --global none" "$prog" --quiet --json --stream --global none "$dir/sphere.xyz" "$dir/g_sn.xyz"
 check "streamed json global is null with --global none" grep -q '"global": null' "$dir/out.txt"
+# two layers 0.006 apart, closer than the spacing (0.02), normals +-z at random:
+# the layer edges give them opposite signs, and without them the graph makes
+# both alike
+awk 'BEGIN { srand(3); for (i = 0; i < 50; i++) for (j = 0; j < 50; j++) {
+  x = (i + 0.3 * rand()) / 50; y = (j + 0.3 * rand()) / 50
+  print x, y, 0, 0, 0, (rand() < 0.5 ? 1 : -1); print x + 0.007, y + 0.005, 0.006, 0, 0, (rand() < 0.5 ? 1 : -1) } }' \
+  > "$dir/two_layers.xyz"
+# prints the number of points on the upper layer whose normal points up, then on the lower one
+layer_signs() { awk '{ if ($3 > 0.003) { if ($6 > 0) t++ } else if ($6 > 0) b++ } END { print t + 0, b + 0 }' "$1"; }
+for mode in "" "--stream"; do
+  # shellcheck disable=SC2086
+  expect_exit 0 "$mode two layers" "$prog" --quiet --json $mode "$dir/two_layers.xyz" "$dir/le_on.xyz"
+  check "$mode two layers: json counts the points on two layers" grep -q '"layer_pairs": [1-9]' "$dir/out.txt"
+  check "$mode two layers: opposite signs" test "$(layer_signs "$dir/le_on.xyz")" = "2500 0" -o \
+    "$(layer_signs "$dir/le_on.xyz")" = "0 2500"
+  # shellcheck disable=SC2086
+  expect_exit 0 "$mode --layer-edges off" "$prog" --quiet --json $mode --layer-edges off "$dir/two_layers.xyz" \
+    "$dir/le_off.xyz"
+  check "$mode --layer-edges off: no point on two layers" grep -q '"layer_pairs": 0,' "$dir/out.txt"
+  check "$mode --layer-edges off: both layers alike" test "$(layer_signs "$dir/le_off.xyz")" = "2500 2500" -o \
+    "$(layer_signs "$dir/le_off.xyz")" = "0 0"
+done
 
 # bad options: exit 2, one line on stderr, no output (the options of --stream
 # need it)
@@ -392,7 +414,8 @@ for args in "--k 0" "--k x" "--radius -1" "--criterion foo" "--solver foo" "--or
     "--stream --min-component-size -1" "--stream --min-component-size x" "--write-segments" \
     "--stream --write-segments" "--batch-size 10" "--stream --batch-size 0" "--stream --batch-size x" \
     "--keep-order" "--stream --keep-order --ascii" "--stream --keep-order --write-segments" "--refine 1" \
-    "--stream --refine 65" "--stream --refine x" "--global foo" "--global" "--stream --global x" "--up 1,2" "--up" "--up 0,0,nan" "--stream --up x,y,z"; do
+    "--stream --refine 65" "--stream --refine x" "--global foo" "--global" "--stream --global x" "--up 1,2" "--up" "--up 0,0,nan" "--stream --up x,y,z" \
+    "--layer-edges" "--layer-edges yes" "--stream --layer-edges 0"; do
   # shellcheck disable=SC2086
   expect_exit 2 "bad option $args" "$prog" $args "$dir/sphere.xyz" "$dir/bad_opt.xyz"
   check "one-line error for $args" test "$(wc -l < "$dir/err.txt")" -eq 1

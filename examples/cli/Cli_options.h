@@ -46,6 +46,7 @@ struct Options
   double prior_weight = 0.0;           ///< --prior-weight (0: no prior)
   std::string global = "auto";         ///< --global: auto, visibility, winding or none
   std::array<double, 3> up = {{0, 0, 1}}; ///< --up
+  bool layer_edges = true;             ///< --layer-edges
   std::string normals = "jet";         ///< --normals
   unsigned int normal_k = 18;          ///< --normal-k
   int threads = 0;                     ///< --threads (0: all cores)
@@ -98,6 +99,9 @@ inline const char* usage_text()
          "                       weigh less, and components whose top surface faces down\n"
          "                       are negated (default 0,0,1; 0,0,0: no up direction, for an\n"
          "                       object scanned from below)\n"
+         "  --layer-edges on|off negate the edges across two layers closer than the\n"
+         "                       neighbour distance (thin parts, contacts) so that they get\n"
+         "                       opposite signs (default on; off: the paper's graph)\n"
          "  --normals NAME       estimator when IN has no normals: jet (default), pca\n"
          "  --normal-k N         neighbours of the normal estimator (default 18)\n"
          "  --threads N          at most N threads (default, or 0: all cores); the output\n"
@@ -208,6 +212,11 @@ bool read_option(Options& o, const std::string& a, const Value& value)
     o.global = value();
     if (o.global != "auto" && o.global != "visibility" && o.global != "winding" && o.global != "none")
       throw Usage_error("unknown global stage '" + o.global + "' (auto, visibility, winding, none)");
+  } else if (a == "--layer-edges") {
+    const std::string v = value();
+    if (v != "on" && v != "off")
+      throw Usage_error("--layer-edges takes on or off, not '" + v + "'");
+    o.layer_edges = v == "on";
   } else if (a == "--up") {
     parse_triple(a, value(), o.up.data());
   } else if (a == "--viewpoint") {

@@ -368,6 +368,13 @@ void core_component_signs(const Neighbor_graph& graph, WeightMap weight, const S
 ///     \cgalParamDescription{a model of `FlipCriterion`}
 ///     \cgalParamDefault{`Hoppe_konig_criterion()`}
 ///   \cgalParamNEnd
+///   \cgalParamNBegin{layer_edges}
+///     \cgalParamDescription{whether the edges across two layers closer than the neighbour distance
+///       are negated (`build_neighbor_graph()`), and the layer cues run; off, the graph is the
+///       paper's}
+///     \cgalParamType{`bool`}
+///     \cgalParamDefault{`true`}
+///   \cgalParamNEnd
 ///   \cgalParamNBegin{solver}
 ///     \cgalParamDescription{a model of `OrientationSolver`}
 ///     \cgalParamDefault{`Qpbo_i_solver(3, random_seed)`: MST, then QPBO-I on the segment graph; on the
@@ -479,7 +486,8 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       const Neighbor_graph_report gr =
         build_neighbor_graph<ConcurrencyTag, Kernel>(in.points, in.normals, settings.number_of_neighbors,
                                                      settings.neighbor_radius, criterion, graph,
-                                                     progress.part(Stage::GRAPH, 0.0, 0.8), true, &layer_offsets);
+                                                     progress.part(Stage::GRAPH, 0.0, 0.8), settings.layer_edges,
+                                                     &layer_offsets);
       internal::add_graph_report(gr, result);
       const auto weight = get(&Neighbor_edge::weight, graph);
       const internal::Layer_pairs layer_pairs = internal::core_layer_pairs(layer_offsets, graph, weight);

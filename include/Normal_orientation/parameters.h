@@ -10,7 +10,7 @@
 /// pack built with `CGAL::parameters::point_map(pm).normal_map(nm)` is accepted
 /// as is.  CGAL's list of names is closed, so the package's own names
 /// (`number_of_neighbors`, `flip_criterion`, `solver`, `component_sign`,
-/// `number_of_threads`, `orientation_prior_map`, `global_orientation`, `up_direction`, and the streaming driver's
+/// `number_of_threads`, `orientation_prior_map`, `global_orientation`, `up_direction`, `layer_edges`, and the streaming driver's
 /// `presorted_axis`, `temporary_directory`, `sort_memory`,
 /// `refinement_rounds`, `minimum_component_size`, `component_files`,
 /// `batch_size`; all the names are described
@@ -49,7 +49,8 @@ namespace internal_np {
   X(component_files_t, component_files, component_files) \
   X(batch_size_t, batch_size, batch_size) \
   X(global_orientation_t, global_orientation, global_orientation) \
-  X(up_direction_t, up_direction, up_direction)
+  X(up_direction_t, up_direction, up_direction) \
+  X(layer_edges_t, layer_edges, layer_edges)
 
 #define NORMAL_ORIENTATION_DECLARE_TAG(X, Y, Z) enum X { Y };
 NORMAL_ORIENTATION_NAMED_PARAMETERS(NORMAL_ORIENTATION_DECLARE_TAG)

@@ -243,7 +243,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   Segmenter segmenter(settings.thresholds);
   Sweep_stage_result swept;
   Segmenting_visitor<ConcurrencyTag, Kernel, FlipCriterion, Unary> visitor(
-    phi, unary, segmenter, records, edges.get(), radius, sweep_progress, n, swept);
+    phi, unary, segmenter, records, edges.get(), radius, sweep_progress, n, swept, settings.layer_edges);
   Sweep_window<Sweep_payload> window;
   Sweep_options so;
   so.number_of_neighbors = k;

@@ -79,8 +79,8 @@ struct Coarse_normal_map
 };
 
 /// The named parameters with which both drivers orient a coarse cloud: the
-/// run's flip criterion, solver, seed, threads and global stage (its mode and
-/// up direction).
+/// run's flip criterion, solver, seed, threads, layer edges and global stage
+/// (its mode and up direction).
 template <typename Kernel, typename FlipCriterion, typename Solver>
 auto coarse_cloud_parameters(const FlipCriterion& criterion, const Solver& solver, const Settings& settings,
                              const Global_settings& global)
@@ -92,6 +92,7 @@ auto coarse_cloud_parameters(const FlipCriterion& criterion, const Solver& solve
     .solver(solver)
     .global_orientation(global.orientation)
     .up_direction(global.up)
+    .layer_edges(settings.layer_edges)
     .random_seed((unsigned int)(settings.random_seed))
     .number_of_threads(settings.number_of_threads);
 }

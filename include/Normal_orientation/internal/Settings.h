@@ -36,6 +36,7 @@ struct Settings
   double neighbor_radius = 0.0;      ///< r; 0: estimate it
   int number_of_threads = 0;         ///< at most this many threads; 0: all
   unsigned long random_seed = 0;     ///< the seed of randomised solvers
+  bool layer_edges = true;           ///< negate the edges across two layers
   Progress_reporter progress;        ///< the callback, wrapped
 };
 
@@ -52,7 +53,7 @@ inline void check_settings(const Settings& s, const char* caller)
     throw std::invalid_argument(std::string(caller) + ": number_of_threads must be >= 0");
 }
 
-/// Reads k, r, the thread count, the seed and the callback of `np`, and
+/// Reads k, r, the thread count, the seed, the layer edges and the callback of `np`, and
 /// checks them (see `check_settings()`).
 template <typename NamedParameters>
 Settings read_settings(const NamedParameters& np, const char* caller)
@@ -66,6 +67,7 @@ Settings read_settings(const NamedParameters& np, const char* caller)
   s.neighbor_radius = double(choose_parameter(get_parameter(np, CGAL::internal_np::neighbor_radius), 0.0));
   s.number_of_threads = int(choose_parameter(get_parameter(np, internal_np::number_of_threads), 0));
   s.random_seed = (unsigned long)(choose_parameter(get_parameter(np, CGAL::internal_np::random_seed), 0u));
+  s.layer_edges = bool(choose_parameter(get_parameter(np, internal_np::layer_edges), true));
   if constexpr (!CGAL::parameters::is_default_parameter<NamedParameters, CGAL::internal_np::callback_t>::value)
     s.progress = Progress_reporter(get_parameter(np, CGAL::internal_np::callback));
   check_settings(s, caller);

@@ -72,7 +72,8 @@ struct Sweep_stage_result
 
 /// The visitor of `sweep()` for the streaming driver.  `Unary` is callable
 /// as `double(const Point_record&)`: the point's preference for its input
-/// sign (> 0 keep, < 0 flip, 0 none; see `orient_normals()`).
+/// sign (> 0 keep, < 0 flip, 0 none; see `orient_normals()`).  Without
+/// `layer_edges`, no layer offset is fitted and no edge is negated.
 template <typename ConcurrencyTag, typename Kernel, typename FlipCriterion, typename Unary>
 class Segmenting_visitor
 {
@@ -82,9 +83,10 @@ class Segmenting_visitor
 public:
   Segmenting_visitor(const FlipCriterion& criterion, const Unary& unary, Segmenter& segmenter,
                      Record_file<Swept_record>& records, Record_file<Earlier_edge>* edges, double radius,
-                     const Progress_reporter& progress, std::uint64_t n, Sweep_stage_result& out)
+                     const Progress_reporter& progress, std::uint64_t n, Sweep_stage_result& out,
+                     bool layer_edges = true)
     : m_criterion(criterion), m_unary(unary), m_segmenter(segmenter), m_records(records), m_edges(edges),
-      m_r2(radius * radius), m_progress(progress), m_n(n), m_out(out)
+      m_r2(radius * radius), m_progress(progress), m_n(n), m_out(out), m_layer_edges(layer_edges)
   {}
 
   /// The layer offsets and the edge weights of a whole batch, in parallel,
@@ -97,28 +99,33 @@ public:
   {
     m_progress.report(first, m_n); // `first` points are finalised
     const std::size_t count = offsets.size() - 1;
-    Normal_orientation::internal::fit_layer_offsets<ConcurrencyTag>(
-      count,
-      [&](std::size_t q, double* p, double* u) {
-        const Point_record& r = w.record(first + q);
-        for (int d = 0; d < 3; ++d) {
-          p[d] = r.position[d];
-          u[d] = r.normal[d];
-        }
-      },
-      [&](std::size_t q, auto&& f) {
-        nearest.for_each(q, [&](std::uint64_t j, float) {
-          if (j >= first && j < first + count)
-            f(w.record(j).position, std::size_t(j - first), Normal_orientation::internal::ONE_LAYER, m_none);
-          else if (j < first)
-            f(w.record(j).position, Normal_orientation::internal::no_local, w.payload(j).layer_state,
-              w.payload(j).layer);
-          else // (a later batch's: not fitted yet)
-            f(w.record(j).position, Normal_orientation::internal::no_local, Normal_orientation::internal::ONE_LAYER,
-              m_none);
-        });
-      },
-      m_layers, m_states);
+    if (m_layer_edges) {
+      Normal_orientation::internal::fit_layer_offsets<ConcurrencyTag>(
+        count,
+        [&](std::size_t q, double* p, double* u) {
+          const Point_record& r = w.record(first + q);
+          for (int d = 0; d < 3; ++d) {
+            p[d] = r.position[d];
+            u[d] = r.normal[d];
+          }
+        },
+        [&](std::size_t q, auto&& f) {
+          nearest.for_each(q, [&](std::uint64_t j, float) {
+            if (j >= first && j < first + count)
+              f(w.record(j).position, std::size_t(j - first), Normal_orientation::internal::ONE_LAYER, m_none);
+            else if (j < first)
+              f(w.record(j).position, Normal_orientation::internal::no_local, w.payload(j).layer_state,
+                w.payload(j).layer);
+            else // (a later batch's: not fitted yet)
+              f(w.record(j).position, Normal_orientation::internal::no_local, Normal_orientation::internal::ONE_LAYER,
+                m_none);
+          });
+        },
+        m_layers, m_states);
+    } else {
+      m_layers.assign(count, m_none);
+      m_states.assign(count, Normal_orientation::internal::ONE_LAYER);
+    }
     for (std::size_t q = 0; q < count; ++q) {
       Sweep_payload& payload = w.payload(first + q);
       payload.layer = m_layers[q];
@@ -211,6 +218,7 @@ private:
   const Progress_reporter& m_progress;
   std::uint64_t m_n;
   Sweep_stage_result& m_out;
+  bool m_layer_edges;
   std::vector<Neighbor_vote> m_votes;
   std::vector<float> m_weights;
   std::vector<Normal_orientation::internal::Layer_offset> m_layers;
