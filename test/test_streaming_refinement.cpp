@@ -308,6 +308,24 @@ TEST(Streaming_refinement, SkippedWhenNothingContradicts)
   EXPECT_EQ(directory.count(), 0u);
 }
 
+// The rounds run only when the energy is above a millionth of the total
+// weight of the edges (the 20M bunny's 12.7 out of about 1.3e8 is not; a
+// 1M cloud's 1,100 out of 6.5e6 is), and never at energy 0, whatever the
+// fraction.
+TEST(Streaming_refinement, SkippedWhenTheEnergyIsNegligible)
+{
+  NO::streaming::Refinement_options o;
+  EXPECT_EQ(o.negligible_energy, 1e-6);
+  EXPECT_FALSE(o.worth_running(12.7, 1.3e8));
+  EXPECT_TRUE(o.worth_running(1111.0, 6.5e6));
+  EXPECT_FALSE(o.worth_running(0.99, 1e6));
+  EXPECT_TRUE(o.worth_running(1.01, 1e6));
+  EXPECT_FALSE(o.worth_running(0.0, 0.0));
+  o.negligible_energy = 0.0;
+  EXPECT_TRUE(o.worth_running(1e-9, 1e9));
+  EXPECT_FALSE(o.worth_running(0.0, 1e9));
+}
+
 // The disk fills up during the refinement (its label files), or the run is
 // cancelled there: one clear error, nothing handed to the sink, no temporary
 // file left (the record file, the edge file and the label files).

@@ -270,9 +270,10 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   result.seconds.sweep = seconds_since(t);
 
   // 5-8. The segment graph and its solution, the refinement (skipped when
-  // no edge contradicts the labelling: its energy, known from the segment
-  // graph, is 0), the sign of every component, then the global stage
-  // (exterior visibility and the winding number of a subsample).
+  // the labelling's energy, known from the segment graph, is negligible:
+  // `Refinement_options::negligible_energy`), the sign of every component,
+  // then the global stage (exterior visibility and the winding number of a
+  // subsample).
   Segment_solution solution;
   Point_labels labels;
   std::vector<char> flip_component;
@@ -295,7 +296,10 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     result.energy_after_refinement = result.energy_before_refinement;
     if (refine && with_refinement) {
       t = Clock::now();
-      const unsigned int rounds = result.energy_before_refinement > 0.0 ? settings.refinement.rounds : 0;
+      const unsigned int rounds =
+        settings.refinement.worth_running(result.energy_before_refinement, swept.total_weight)
+          ? settings.refinement.rounds
+          : 0;
       const Refine_stage_result rr = refine_stage<ConcurrencyTag>(
         records, *edges, n, result.edge_span, settings.refinement, rounds, settings.temporary_directory, the_solver,
         result.energy_before_refinement, labels, stage(Stage::REFINE));

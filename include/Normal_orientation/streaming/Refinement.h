@@ -80,6 +80,19 @@ struct Refinement_options
   double shrink = 4.0;
   /// the size limit is never below this
   std::size_t smallest_segment = 64;
+  /// no round runs when the energy of the solved segment graph's labelling
+  /// is at most this fraction of the total absolute weight of the edges:
+  /// the refinement could lower it by no more (0: no round runs only when
+  /// no edge contradicts the labelling)
+  double negligible_energy = 1e-6;
+
+  /// whether the rounds run, for a labelling of energy `energy` in a graph
+  /// whose edges' absolute weights sum to `total_weight`: when the energy
+  /// is positive and above `negligible_energy` times `total_weight`
+  bool worth_running(double energy, double total_weight) const
+  {
+    return energy > 0.0 && energy > negligible_energy * total_weight;
+  }
 
   /// the size limit of the segments of round `round` for `n` points
   std::size_t maximum_segment_size(std::uint64_t n, unsigned int round) const

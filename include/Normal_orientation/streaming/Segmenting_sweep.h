@@ -67,6 +67,7 @@ struct Sweep_stage_result
   std::uint64_t edge_span = 0;       ///< the farthest back an edge reaches
   std::uint64_t unary_terms = 0;     ///< points with a unary term
   double energy_before = 0.0;        ///< the energy of the input orientation, summed in the sweep order
+  double total_weight = 0.0;         ///< the sum of the edges' absolute weights, in the sweep order
   std::uint64_t two_layer_points = 0; ///< points on two layers (`build_neighbor_graph()`)
 };
 
@@ -178,6 +179,7 @@ public:
       const float weight = m_weights[m_cursor++];
       m_votes.push_back({pq.segment, double(weight) * double(pq.flip)});
       m_out.energy_before += edge_energy(double(weight), Label(1), Label(1));
+      m_out.total_weight += std::abs(double(weight));
       if (m_edges != nullptr)
         m_edges->append(Earlier_edge{std::uint32_t(s - nb.sequence), weight});
     }
