@@ -85,7 +85,7 @@ public:
   Segmenting_visitor(const FlipCriterion& criterion, const Unary& unary, Segmenter& segmenter,
                      Record_file<Swept_record>& records, Record_file<Earlier_edge>* edges, double radius,
                      const Progress_reporter& progress, std::uint64_t n, Sweep_stage_result& out,
-                     bool layer_edges = true)
+                     bool layer_edges)
     : m_criterion(criterion), m_unary(unary), m_segmenter(segmenter), m_records(records), m_edges(edges),
       m_r2(radius * radius), m_progress(progress), m_n(n), m_out(out), m_layer_edges(layer_edges)
   {}
