@@ -36,7 +36,7 @@ struct Global_sign_summary
   /// the gap are negated (`build_neighbor_graph()`); set with or without
   /// the stage
   std::size_t layer_pairs = 0;
-  std::size_t layer_cues = 0;          ///< of `layer_pairs`, those with a sure cue from the far field (in core; 0 streamed)
+  std::size_t layer_cues = 0;          ///< of `layer_pairs`, those with a sure cue from the far field (streamed: of the samples)
   std::size_t layer_cues_against = 0;  ///< of `layer_cues`, those whose sign the cue negated
   bool layer_cue_round = false;        ///< the solver and the stage ran again, with the cues as unary terms
   /// the fraction of the sampled area where w is within the tolerance of

@@ -278,10 +278,18 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   Point_labels labels;
   std::vector<char> flip_component;
   Labelled_reader points(records, labels);
+  // Layer cues (Stream_layer_cues.h): not with the user's unary terms; a
+  // second solve with them as unary terms of the sweep's segments when they
+  // negate enough samples.
+  constexpr bool cues_possible = !Unary::enabled && solves_segments_with_unary<Solver>();
+  const bool want_cues = cues_possible && settings.layer_edges && global.orientation != Global_orientation::NONE;
+  Stream_layer_cues cues;
+  bool cue_round = false;
+  std::vector<char> cue_has_unary; // (per sweep segment, in the cue round: the user's or the cues' fixed components)
   auto fine = [&](const auto& the_solver, bool with_refinement, bool dense) {
     t = Clock::now();
     stage(Stage::SOLVE).report(0, 1);
-    solution = solve_segment_graph_stage(segmenter, the_solver, Unary::enabled);
+    solution = solve_segment_graph_stage(segmenter, the_solver, Unary::enabled, cue_round ? &cues.preference : nullptr);
     result.number_of_segments = segmenter.number_of_segments();
     result.number_of_segment_edges = solution.number_of_segment_edges;
     result.segment_energy_before = solution.energy_before;
@@ -294,7 +302,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     labels.segment_labels = solution.labels;
     result.energy_before_refinement = segmenter.point_energy(solution.labels);
     result.energy_after_refinement = result.energy_before_refinement;
-    if (refine && with_refinement) {
+    if (refine && with_refinement && !cue_round) {
       t = Clock::now();
       const unsigned int rounds =
         settings.refinement.worth_running(result.energy_before_refinement, swept.total_weight)
@@ -311,19 +319,21 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     result.energy_after = result.energy_after_refinement;
 
     t = Clock::now();
+    const std::vector<char>& has_unary = cue_round ? cue_has_unary : swept.segment_has_unary;
     flip_component = sign_stage(
       sign_policy, [&unary](const Point_record& r) { return unary.is_constrained(r); }, points, solution.component,
-      solution.number_of_components, swept.segment_size, swept.segment_has_unary, radius, n, stage(Stage::SIGN));
+      solution.number_of_components, swept.segment_size, has_unary, radius, n, stage(Stage::SIGN));
     result.seconds.sign += seconds_since(t);
 
     if (global.orientation != Global_orientation::NONE) {
       t = Clock::now();
       Normal_orientation::internal::Global_settings g = global;
       g.dense_samples = dense;
-      result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component,
-                                                   swept.segment_has_unary, radius, n, g, stage(Stage::GLOBAL),
+      result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component, has_unary,
+                                                   radius, n, g, stage(Stage::GLOBAL),
                                                    Unit_inputs{edges.get(), result.edge_span,
-                                                               settings.temporary_directory});
+                                                               settings.temporary_directory},
+                                                   want_cues && dense && !cue_round ? &cues : nullptr, double(k));
       result.seconds.global += seconds_since(t);
     }
   };
@@ -338,6 +348,21 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
                          result.global, result.seconds.global);
   } else {
     fine(solver, true, true);
+  }
+  // The layer cues' round, as in core (`layer_cue_round_share`).
+  if (want_cues) {
+    const bool round = !cues.preference.empty() &&
+                       double(cues.against) > Normal_orientation::internal::layer_cue_round_share * double(cues.samples);
+    if (round) { // (`cues` stays: the round does not ask for cues)
+      cue_has_unary.assign(solution.component.size(), 0);
+      for (std::size_t s = 0; s < cue_has_unary.size(); ++s)
+        cue_has_unary[s] = char(swept.segment_has_unary[s] || cues.fixed_component[solution.component[s]]);
+      cue_round = true;
+      fine(solver, false, true);
+    }
+    result.global.layer_cues = cues.sure;
+    result.global.layer_cues_against = cues.against;
+    result.global.layer_cue_round = round;
   }
   result.global.layer_pairs = swept.two_layer_points;
   edges.reset(); // removes the edge file

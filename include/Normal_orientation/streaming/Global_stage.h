@@ -16,6 +16,7 @@
 #include <Normal_orientation/streaming/Labelled_records.h>
 #include <Normal_orientation/streaming/Patch_units.h>
 #include <Normal_orientation/streaming/Segmenting_sweep.h>
+#include <Normal_orientation/streaming/Stream_layer_cues.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
@@ -47,6 +48,10 @@ struct Global_samples
   std::vector<std::uint32_t> component;           ///< component
   std::vector<std::uint32_t> unit;                ///< patch unit (with `Patch_units`)
   std::vector<char> two_layers;                   ///< on two layers (`Swept_record::two_layers`)
+  std::vector<std::uint16_t> layer;               ///< `Swept_record::two_layers` (`layer_code()`)
+  std::vector<signed char> sign;                  ///< the oriented normal over the input normal, +1 or -1
+  std::vector<std::uint32_t> sweep_segment;       ///< the sweep's segment (`Swept_record::segment`)
+  std::vector<signed char> sweep_flip;            ///< the sweep's flip in it (`Swept_record::flip`)
 };
 
 /// What the global stage needs to build its patches from units
@@ -101,6 +106,10 @@ Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std
       out.component.push_back(c);
       out.unit.push_back(unit);
       out.two_layers.push_back(char(s.two_layers != 0));
+      out.layer.push_back(s.two_layers);
+      out.sign.push_back(sign < 0.0 ? -1 : 1);
+      out.sweep_segment.push_back(s.segment);
+      out.sweep_flip.push_back(s.flip < 0 ? -1 : 1);
     }
   }
   if (unit_file)
@@ -353,14 +362,18 @@ void stream_winding_levels(const Global_samples<Kernel>& samples, Winding_patch_
 /// point follows its unit (a unit file installed in `labels`); else the
 /// points follow the samples (`Global_point_flips`).  Whole components
 /// negate in `flip_component` (the sign stage's decision, per component).
-/// `component` and `segment_has_unary` are per sweep segment.  Memory: the
-/// subsample, the units and O(segments).
+/// `component` and `segment_has_unary` are per sweep segment.  With
+/// `cues`, the layer cues of the final signs go there
+/// (`stream_layer_cues()`), each as strong as `cue_strength` per point that
+/// its sample stands for.  Memory: the subsample, the units and
+/// O(segments).
 template <typename ConcurrencyTag>
 Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
                                  const std::vector<std::uint32_t>& component, std::vector<char>& flip_component,
                                  const std::vector<char>& segment_has_unary, double radius, std::uint64_t n,
                                  const Normal_orientation::internal::Global_settings& settings,
-                                 const Progress_reporter& progress, const Unit_inputs& unit_inputs = Unit_inputs())
+                                 const Progress_reporter& progress, const Unit_inputs& unit_inputs = Unit_inputs(),
+                                 Stream_layer_cues* cues = nullptr, double cue_strength = 0.0)
 {
   typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
   const auto t0 = std::chrono::steady_clock::now();
@@ -436,6 +449,13 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
     samples.points, oriented, areas, samples.component, nc, component_fixed, settings);
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
+  if (cues) {
+    std::vector<char> final_flip(ns);
+    for (std::size_t j = 0; j < ns; ++j)
+      final_flip[j] = char((seen.seen.component[samples.component[j]] != sample_flip[j]) != (top[samples.component[j]] != 0));
+    *cues = stream_layer_cues<ConcurrencyTag, Kernel>(samples, final_flip, areas, radius, component.size(), nc,
+                                                      double(stride) * cue_strength);
+  }
   progress.report(3, 4);
   report.points_flipped = 0; // (counted in core only)
   if (units) {

@@ -19,6 +19,8 @@
 #include <boost/property_map/property_map.hpp>
 
 #include <cstdint>
+#include <stdexcept>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -37,10 +39,25 @@ struct Segment_solution
   double energy_before = 0.0, energy_after = 0.0; ///< of the segment graph (its edges)
 };
 
-/// Solves the segment graph of `segmenter` with `solver`, with the
-/// segments' unary preferences when `with_unary`.
+/// Whether `Solver` solves the segment graph with unary terms.
 template <typename Solver>
-Segment_solution solve_segment_graph_stage(const Segmenter& segmenter, const Solver& solver, bool with_unary)
+constexpr bool solves_segments_with_unary()
+{
+  typedef std::pair<double, double> Costs;
+  typedef decltype(get(&Neighbor_edge::weight, std::declval<const Neighbor_graph&>())) Weight;
+  typedef decltype(boost::make_iterator_property_map(std::declval<std::vector<Costs>&>().begin(),
+                                                     get(boost::vertex_index, std::declval<const Neighbor_graph&>())))
+    Unary;
+  typedef decltype(CGAL::make_property_map(std::declval<std::vector<Label>&>())) Labels;
+  return Normal_orientation::internal::Accepts_unary<Solver, Neighbor_graph, Weight, Unary, Labels>::value;
+}
+
+/// Solves the segment graph of `segmenter` with `solver`, with the
+/// segments' unary preferences when `with_unary`, plus `extra` (per
+/// segment, in the same frame) when it is not null.
+template <typename Solver>
+Segment_solution solve_segment_graph_stage(const Segmenter& segmenter, const Solver& solver, bool with_unary,
+                                           const std::vector<double>* extra = nullptr)
 {
   Segment_solution out;
   const std::size_t ns = segmenter.number_of_segments();
@@ -50,12 +67,14 @@ Segment_solution solve_segment_graph_stage(const Segmenter& segmenter, const Sol
   out.labels.assign(ns, Label(1));
   const auto labels = CGAL::make_property_map(out.labels);
   out.energy_before = energy(sg, weight, labels);
-  if (with_unary) {
+  if (with_unary || extra != nullptr) {
     typedef std::pair<double, double> Costs;
     std::vector<Costs> unary(ns, Costs(0.0, 0.0));
     const std::vector<double>& preference = segmenter.segment_preferences();
-    for (std::size_t s = 0; s < ns; ++s) // > 0: keep the preliminary orientation (label +1)
-      unary[s] = preference[s] > 0.0 ? Costs(0.0, preference[s]) : Costs(-preference[s], 0.0);
+    for (std::size_t s = 0; s < ns; ++s) { // > 0: keep the preliminary orientation (label +1)
+      const double p = (with_unary ? preference[s] : 0.0) + (extra != nullptr && s < extra->size() ? (*extra)[s] : 0.0);
+      unary[s] = p > 0.0 ? Costs(0.0, p) : Costs(-p, 0.0);
+    }
     const auto unary_map = boost::make_iterator_property_map(unary.begin(), get(boost::vertex_index, sg));
     if constexpr (Normal_orientation::internal::Accepts_unary<Solver, Neighbor_graph, std::decay_t<decltype(weight)>,
                                                               std::decay_t<decltype(unary_map)>,

@@ -34,7 +34,8 @@ namespace streaming {
 namespace internal {
 
 /// a point after the sweep: the record, its segment, its preliminary flip
-/// and whether its neighbourhood is two layers (`build_neighbor_graph()`)
+/// and, when its neighbourhood is two layers (`build_neighbor_graph()`),
+/// where the other layer lies (`layer_code()`; 0: one layer)
 struct Swept_record
 {
   Point_record record;
@@ -42,6 +43,30 @@ struct Swept_record
   std::int16_t flip;
   std::uint16_t two_layers;
 };
+
+/// The layer offset `t` of a point of unit normal `u` (zero: one layer),
+/// coded in 16 bits for `Swept_record::two_layers`: 0 on one layer; else bit
+/// 15 set when the other layer lies along u, and bits 0-14 the gap |t| in
+/// units of `radius` / 32767 (at least 1).  `layer_code_offset()` reads it
+/// back along u: the fit's line is within a few degrees of the normal line.
+inline std::uint16_t layer_code(const Normal_orientation::internal::Layer_offset& t, const std::array<double, 3>& u,
+                                double radius)
+{
+  if (!Normal_orientation::internal::is_two_layers(t))
+    return 0;
+  const double g = std::sqrt(double(t[0]) * t[0] + double(t[1]) * t[1] + double(t[2]) * t[2]);
+  const double along = double(t[0]) * u[0] + double(t[1]) * u[1] + double(t[2]) * u[2];
+  const double units = std::round(std::min(1.0, g / radius) * 32767.0);
+  return std::uint16_t(std::max(1.0, units)) | std::uint16_t(along > 0.0 ? 0x8000u : 0u);
+}
+
+/// The offset to the other layer that `code` (`layer_code()`, not 0) gives
+/// a point of unit normal `u`.
+inline std::array<double, 3> layer_code_offset(std::uint16_t code, const std::array<double, 3>& u, double radius)
+{
+  const double g = double(code & 0x7fffu) / 32767.0 * radius * ((code & 0x8000u) != 0 ? 1.0 : -1.0);
+  return {{g * u[0], g * u[1], g * u[2]}};
+}
 
 /// what the sweep keeps per point in its window
 struct Sweep_payload
@@ -207,7 +232,7 @@ public:
     const Sweep_payload& p = w.payload(s);
     m_window_two_layers -= Normal_orientation::internal::is_two_layers(p.layer) ? 1 : 0;
     m_records.append(Swept_record{w.record(s), p.segment, std::int16_t(p.flip),
-                                  std::uint16_t(Normal_orientation::internal::is_two_layers(p.layer))});
+                                  layer_code(p.layer, unit_normal(w.record(s)), std::sqrt(m_r2))});
   }
 
 private:
