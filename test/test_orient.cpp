@@ -1087,6 +1087,26 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
                  .global.ran);
 }
 
+namespace {
+
+/// Streams `input` with the named parameters `np` into `result`; returns
+/// the output normals that disagree with `truth` (by input index).
+template <typename Truth, typename Input, typename NamedParameters>
+std::size_t stream_and_count_wrong(const Truth& truth, const Input& input, const NamedParameters& np,
+                                   NO::Streaming_result& result)
+{
+  Rewindable_source src{as_records(input)};
+  std::vector<NO::Point_record> out;
+  auto sink = [&](const NO::Point_record& r) { out.push_back(r); };
+  result = NO::streaming_orient_normals(src, sink, np);
+  std::size_t wrong = 0;
+  for (const auto& r : out)
+    wrong += (Vector(r.normal[0], r.normal[1], r.normal[2]) * truth[r.index].n <= 0.0) ? 1 : 0;
+  return wrong;
+}
+
+} // namespace
+
 TEST(Streaming_orient_normals, LayerCuesInBothDrivers)
 {
   // The layer code of the records: the gap and the side of the other layer
@@ -1111,13 +1131,8 @@ TEST(Streaming_orient_normals, LayerCuesInBothDrivers)
   const auto truth = NO::hard_shapes::hard_shape("thin_pipe", 10000, rng);
   const auto input = unoriented(truth, rng);
   const double n = double(truth.size());
-  Rewindable_source src{as_records(input)};
-  std::vector<NO::Point_record> out;
-  auto sink = [&](const NO::Point_record& r) { out.push_back(r); };
-  const NO::Streaming_result sr = NO::streaming_orient_normals(src, sink, NP::default_values());
-  std::size_t streamed = 0;
-  for (const auto& r : out)
-    streamed += (Vector(r.normal[0], r.normal[1], r.normal[2]) * truth[r.index].n <= 0.0) ? 1 : 0;
+  NO::Streaming_result sr;
+  const std::size_t streamed = stream_and_count_wrong(truth, input, NP::default_values(), sr);
   auto in_core = input;
   const NO::Orientation_result rc = NO::orient_normals(in_core, pn_params());
   const std::size_t core = count_wrong(truth, in_core);
@@ -1143,13 +1158,8 @@ TEST(Streaming_orient_normals, LayerEdgesOffIsThePapersGraphInBothDrivers)
   const auto truth = NO::hard_shapes::hard_shape("thin_plate", 20000, rng);
   const auto input = unoriented(truth, rng);
   const double n = double(truth.size());
-  Rewindable_source src{as_records(input)};
-  std::vector<NO::Point_record> out;
-  auto sink = [&](const NO::Point_record& r) { out.push_back(r); };
-  const NO::Streaming_result sr = NO::streaming_orient_normals(src, sink, NP::layer_edges(false));
-  std::size_t streamed = 0;
-  for (const auto& r : out)
-    streamed += (Vector(r.normal[0], r.normal[1], r.normal[2]) * truth[r.index].n <= 0.0) ? 1 : 0;
+  NO::Streaming_result sr;
+  const std::size_t streamed = stream_and_count_wrong(truth, input, NP::layer_edges(false), sr);
   auto in_core = input;
   const NO::Orientation_result rc = NO::orient_normals(in_core, pn_params().layer_edges(false));
   const std::size_t core = count_wrong(truth, in_core);
