@@ -76,9 +76,7 @@ Segment_solution solve_segment_graph_stage(const Segmenter& segmenter, const Sol
       unary[s] = p > 0.0 ? Costs(0.0, p) : Costs(-p, 0.0);
     }
     const auto unary_map = boost::make_iterator_property_map(unary.begin(), get(boost::vertex_index, sg));
-    if constexpr (Normal_orientation::internal::Accepts_unary<Solver, Neighbor_graph, std::decay_t<decltype(weight)>,
-                                                              std::decay_t<decltype(unary_map)>,
-                                                              std::decay_t<decltype(labels)>>::value)
+    if constexpr (solves_segments_with_unary<Solver>())
       solver.solve(sg, weight, unary_map, labels);
     else
       throw std::invalid_argument("streaming_orient_normals: point_is_constrained_map and orientation_prior_map "

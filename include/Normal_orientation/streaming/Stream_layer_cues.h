@@ -39,6 +39,26 @@ struct Stream_layer_cues
   /// per component, whether a sure cue is at `layer_cue_component_share` of
   /// its samples or more (its sign is then the cues')
   std::vector<char> fixed_component;
+
+  /// whether the solver runs again with the cues: when they negate more
+  /// than `layer_cue_round_share` of the samples, as in core
+  bool ask_for_a_round() const
+  {
+    return !preference.empty() &&
+           double(against) > Normal_orientation::internal::layer_cue_round_share * double(samples);
+  }
+
+  /// per sweep segment (of component `component`), whether it has a unary
+  /// term in that round: the user's (`segment_has_unary`) or a fixed
+  /// component's
+  std::vector<char> segments_with_unary(const std::vector<char>& segment_has_unary,
+                                        const std::vector<std::uint32_t>& component) const
+  {
+    std::vector<char> out(component.size(), 0);
+    for (std::size_t s = 0; s < out.size(); ++s)
+      out[s] = char(segment_has_unary[s] || fixed_component[component[s]]);
+    return out;
+  }
 };
 
 /// The cues of the two-layer samples of `samples` (`Global_samples`, with
