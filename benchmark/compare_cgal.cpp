@@ -712,6 +712,81 @@ Side_result run_side(Child_spawner& spawner, const std::string& label, const std
   return side;
 }
 
+/// Samples `sampler` at `options.points` points and `noise`, runs both
+/// programs on the cloud (alternately, `options.repeat` times) and scores
+/// them; removes the files unless `keep`.
+Row run_cloud(Child_spawner& spawner, const Options& options, Mesh_sampler& sampler, const std::string& mesh_name,
+              double noise, const std::string& work_directory, bool keep)
+{
+  Sampling_options sampling;
+  sampling.number_of_points = options.points;
+  sampling.noise = noise;
+  sampling.seed = options.seed;
+  const auto generation_start = std::chrono::steady_clock::now();
+  const Sampled_cloud cloud = sampler.sample(sampling);
+  const std::string prefix =
+    (fs::path(work_directory) / (mesh_name + "_" + std::to_string(options.points) + "_noise"
+                                 + format("%g", noise)))
+      .string();
+  write_cloud(cloud, prefix);
+  std::fprintf(stderr, "cloud %.2f s",
+               std::chrono::duration<double>(std::chrono::steady_clock::now() - generation_start).count());
+  std::fflush(stderr);
+
+  // Files hold 9 significant digits; this only has to detect a changed point order.
+  double magnitude = cloud.bbox_diagonal;
+  for(const Point_3& p : cloud.points)
+    magnitude = (std::max)({magnitude, std::abs(p.x()), std::abs(p.y()), std::abs(p.z())});
+  const double tolerance = 1e-5 * magnitude;
+
+  const std::string input = prefix + ".xyz";
+  const std::string ours_output = prefix + ".ours.xyz";
+  const std::string cgal_output = prefix + ".cgal.xyz";
+  std::vector<std::string> ours_command = {options.ours, "--quiet"};
+  ours_command.insert(ours_command.end(), options.ours_arguments.begin(), options.ours_arguments.end());
+  ours_command.insert(ours_command.end(), {input, ours_output});
+  std::vector<std::string> cgal_command = {options.peer};
+  cgal_command.insert(cgal_command.end(), options.peer_arguments.begin(), options.peer_arguments.end());
+  cgal_command.insert(cgal_command.end(), {input, cgal_output});
+
+  Row row{mesh_name, options.points, noise, {}, {}};
+  std::string failure_report;
+  // Alternate the two programs so that a load change on the machine hits both alike.
+  struct Side
+  {
+    const char* name;
+    const std::vector<std::string>* command;
+    const std::string* output;
+    const char* suffix;
+    Side_result* result;
+  };
+  const Side sides[2] = {{"ours", &ours_command, &ours_output, ".ours", &row.ours},
+                         {"CGAL", &cgal_command, &cgal_output, ".cgal", &row.cgal}};
+  for(unsigned int r = 0; r < options.repeat; ++r)
+    for(const Side& side : sides)
+    {
+      if(r > 0 && !side.result->ok)
+        continue;
+      const Side_result run = run_side(spawner, side.name, *side.command, *side.output,
+                                       prefix + side.suffix, cloud, tolerance, failure_report);
+      if(r == 0)
+        *side.result = run;
+      else
+        merge_repeat(*side.result, run);
+    }
+  std::fprintf(stderr, ", ours %.2f s%s, CGAL %.2f s%s\n%s", row.ours.child.seconds,
+               row.ours.ok ? "" : " (FAILED)", row.cgal.child.seconds, row.cgal.ok ? "" : " (FAILED)",
+               failure_report.c_str());
+  if(!keep)
+    for(const char* suffix : {".xyz", ".gt.xyz", ".ours.xyz", ".cgal.xyz", ".ours.stdout", ".ours.stderr",
+                              ".cgal.stdout", ".cgal.stderr"})
+    {
+      std::error_code ec;
+      fs::remove(prefix + suffix, ec);
+    }
+  return row;
+}
+
 } // namespace
 
 /// Entry point: see print_usage().
@@ -796,74 +871,7 @@ int main(int argc, char** argv)
                      options.points, noise);
         std::fflush(stderr);
 
-        Sampling_options sampling;
-        sampling.number_of_points = options.points;
-        sampling.noise = noise;
-        sampling.seed = options.seed;
-        const auto generation_start = std::chrono::steady_clock::now();
-        const Sampled_cloud cloud = sampler->sample(sampling);
-        const std::string prefix =
-          (fs::path(work_directory) / (mesh_name + "_" + std::to_string(options.points) + "_noise"
-                                       + format("%g", noise)))
-            .string();
-        write_cloud(cloud, prefix);
-        std::fprintf(stderr, "cloud %.2f s",
-                     std::chrono::duration<double>(std::chrono::steady_clock::now() - generation_start).count());
-        std::fflush(stderr);
-
-        // Files hold 9 significant digits; this only has to detect a changed point order.
-        double magnitude = cloud.bbox_diagonal;
-        for(const Point_3& p : cloud.points)
-          magnitude = (std::max)({magnitude, std::abs(p.x()), std::abs(p.y()), std::abs(p.z())});
-        const double tolerance = 1e-5 * magnitude;
-
-        const std::string input = prefix + ".xyz";
-        const std::string ours_output = prefix + ".ours.xyz";
-        const std::string cgal_output = prefix + ".cgal.xyz";
-        std::vector<std::string> ours_command = {options.ours, "--quiet"};
-        ours_command.insert(ours_command.end(), options.ours_arguments.begin(), options.ours_arguments.end());
-        ours_command.insert(ours_command.end(), {input, ours_output});
-        std::vector<std::string> cgal_command = {options.peer};
-        cgal_command.insert(cgal_command.end(), options.peer_arguments.begin(), options.peer_arguments.end());
-        cgal_command.insert(cgal_command.end(), {input, cgal_output});
-
-        Row row{mesh_name, options.points, noise, {}, {}};
-        std::string failure_report;
-        // Alternate the two programs so that a load change on the machine hits both alike.
-        struct Side
-        {
-          const char* name;
-          const std::vector<std::string>* command;
-          const std::string* output;
-          const char* suffix;
-          Side_result* result;
-        };
-        const Side sides[2] = {{"ours", &ours_command, &ours_output, ".ours", &row.ours},
-                               {"CGAL", &cgal_command, &cgal_output, ".cgal", &row.cgal}};
-        for(unsigned int r = 0; r < options.repeat; ++r)
-          for(const Side& side : sides)
-          {
-            if(r > 0 && !side.result->ok)
-              continue;
-            const Side_result run = run_side(spawner, side.name, *side.command, *side.output,
-                                             prefix + side.suffix, cloud, tolerance, failure_report);
-            if(r == 0)
-              *side.result = run;
-            else
-              merge_repeat(*side.result, run);
-          }
-        std::fprintf(stderr, ", ours %.2f s%s, CGAL %.2f s%s\n%s", row.ours.child.seconds,
-                     row.ours.ok ? "" : " (FAILED)", row.cgal.child.seconds, row.cgal.ok ? "" : " (FAILED)",
-                     failure_report.c_str());
-        rows.push_back(row);
-
-        if(!keep)
-          for(const char* suffix : {".xyz", ".gt.xyz", ".ours.xyz", ".cgal.xyz", ".ours.stdout", ".ours.stderr",
-                                    ".cgal.stdout", ".cgal.stderr"})
-          {
-            std::error_code ec;
-            fs::remove(prefix + suffix, ec);
-          }
+        rows.push_back(run_cloud(spawner, options, *sampler, mesh_name, noise, work_directory, keep));
       }
     }
   }

@@ -452,6 +452,67 @@ void write_png(const std::string& path, const std::vector<unsigned char>& pixels
   }
 }
 
+/// Per point, the colour of its segment (`o.property`, an integer vertex
+/// property of `cloud`); sets `number_of_segments` to the distinct values.
+std::vector<Color> segment_colors_of(const NO::IO::Point_cloud& cloud, const Options& o,
+                                     std::size_t& number_of_segments)
+{
+  const std::size_t n = cloud.size();
+  std::vector<Color> segment_colors;
+  const std::vector<NO::IO::Ply_property>& properties = cloud.extra_properties;
+  std::size_t column = properties.size();
+  std::string names;
+  for(std::size_t k = 0; k < properties.size(); ++k)
+  {
+    if(properties[k].name == o.property)
+      column = k;
+    names += (names.empty() ? "" : ", ") + properties[k].name;
+  }
+  if(column == properties.size())
+    throw std::runtime_error("'" + o.cloud + "' has no vertex property '" + o.property + "' (" +
+                             (names.empty() ? std::string("no extra property") : "extra properties: " + names) + ")");
+  segment_colors.resize(n);
+  std::vector<std::int64_t> ids(n);
+  for(std::size_t i = 0; i < n; ++i)
+  {
+    const double v = cloud.extra_values[i * properties.size() + column];
+    if(!(std::fabs(v) < 9.0e15) || v != std::trunc(v))
+      throw std::runtime_error("'" + o.cloud + "': vertex " + std::to_string(i) + ": property '" + o.property +
+                               "' is not an integer");
+    ids[i] = static_cast<std::int64_t>(v);
+    segment_colors[i] = segment_color(ids[i]);
+  }
+  std::sort(ids.begin(), ids.end());
+  number_of_segments = static_cast<std::size_t>(std::unique(ids.begin(), ids.end()) - ids.begin());
+  return segment_colors;
+}
+
+/// Per point of `cloud`, 1 where its normal is wrong against the reference
+/// mesh `o.reference`.
+std::vector<char> wrong_normals_of(const NO::IO::Point_cloud& cloud, const Options& o)
+{
+  const std::size_t n = cloud.size();
+  std::vector<char> wrong;
+  const NB::Reference_normals reference(o.reference);
+  wrong.assign(n, 0);
+  auto evaluate = [&](std::size_t begin, std::size_t end) {
+    std::vector<NB::Mesh_triangle_iterator> candidates;
+    for(std::size_t i = begin; i < end; ++i)
+    {
+      const std::array<double, 3>& p = cloud.points[i];
+      const std::pair<NB::Vector_3, double> truth = reference.truth(NB::Point_3(p[0], p[1], p[2]), candidates);
+      wrong[i] = NB::Reference_normals::is_wrong(truth.first, cloud.normals[i].data()) ? 1 : 0;
+    }
+  };
+#ifdef CGAL_LINKED_WITH_TBB
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 2048),
+                    [&](const tbb::blocked_range<std::size_t>& r) { evaluate(r.begin(), r.end()); });
+#else
+  evaluate(0, n);
+#endif
+  return wrong;
+}
+
 /// Renders the cloud; returns the exit status.
 int run(const Options& o)
 {
@@ -465,56 +526,14 @@ int run(const Options& o)
   std::vector<Color> segment_colors; // per point, mode SEGMENTS
   std::size_t number_of_segments = 0;
   if(o.mode == Color_mode::SEGMENTS)
-  {
-    const std::vector<NO::IO::Ply_property>& properties = cloud.extra_properties;
-    std::size_t column = properties.size();
-    std::string names;
-    for(std::size_t k = 0; k < properties.size(); ++k)
-    {
-      if(properties[k].name == o.property)
-        column = k;
-      names += (names.empty() ? "" : ", ") + properties[k].name;
-    }
-    if(column == properties.size())
-      throw std::runtime_error("'" + o.cloud + "' has no vertex property '" + o.property + "' (" +
-                               (names.empty() ? std::string("no extra property") : "extra properties: " + names) + ")");
-    segment_colors.resize(n);
-    std::vector<std::int64_t> ids(n);
-    for(std::size_t i = 0; i < n; ++i)
-    {
-      const double v = cloud.extra_values[i * properties.size() + column];
-      if(!(std::fabs(v) < 9.0e15) || v != std::trunc(v))
-        throw std::runtime_error("'" + o.cloud + "': vertex " + std::to_string(i) + ": property '" + o.property +
-                                 "' is not an integer");
-      ids[i] = static_cast<std::int64_t>(v);
-      segment_colors[i] = segment_color(ids[i]);
-    }
-    std::sort(ids.begin(), ids.end());
-    number_of_segments = static_cast<std::size_t>(std::unique(ids.begin(), ids.end()) - ids.begin());
-  }
+    segment_colors = segment_colors_of(cloud, o, number_of_segments);
 
   // Wrong normals against the reference mesh.
   std::vector<char> wrong;
   std::size_t number_of_wrong = 0;
   if(o.mode == Color_mode::WRONG)
   {
-    const NB::Reference_normals reference(o.reference);
-    wrong.assign(n, 0);
-    auto evaluate = [&](std::size_t begin, std::size_t end) {
-      std::vector<NB::Mesh_triangle_iterator> candidates;
-      for(std::size_t i = begin; i < end; ++i)
-      {
-        const std::array<double, 3>& p = cloud.points[i];
-        const std::pair<NB::Vector_3, double> truth = reference.truth(NB::Point_3(p[0], p[1], p[2]), candidates);
-        wrong[i] = NB::Reference_normals::is_wrong(truth.first, cloud.normals[i].data()) ? 1 : 0;
-      }
-    };
-#ifdef CGAL_LINKED_WITH_TBB
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 2048),
-                      [&](const tbb::blocked_range<std::size_t>& r) { evaluate(r.begin(), r.end()); });
-#else
-    evaluate(0, n);
-#endif
+    wrong = wrong_normals_of(cloud, o);
     number_of_wrong = static_cast<std::size_t>(std::count(wrong.begin(), wrong.end(), char(1)));
   }
 

@@ -47,15 +47,19 @@ double seconds_since(std::chrono::steady_clock::time_point t0)
   std::exit(2);
 }
 
-} // namespace
-
-int main(int argc, char** argv)
+/// the command line
+struct Options
 {
   std::size_t n = 1000000, m = 0, check = 300;
   std::vector<double> betas = {1.5, 2.0, 3.0};
   double smoothing = NO::default_smoothing_factor;
   unsigned long long seed = 1;
   std::string mesh;
+};
+
+Options parse(int argc, char** argv)
+{
+  Options o;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (i + 1 >= argc)
@@ -63,24 +67,24 @@ int main(int argc, char** argv)
     const char* v = argv[++i];
     char* end = nullptr;
     if (a == "--points")
-      n = std::strtoull(v, &end, 10);
+      o.n = std::strtoull(v, &end, 10);
     else if (a == "--queries")
-      m = std::strtoull(v, &end, 10);
+      o.m = std::strtoull(v, &end, 10);
     else if (a == "--check")
-      check = std::strtoull(v, &end, 10);
+      o.check = std::strtoull(v, &end, 10);
     else if (a == "--smoothing")
-      smoothing = std::strtod(v, &end);
+      o.smoothing = std::strtod(v, &end);
     else if (a == "--seed")
-      seed = std::strtoull(v, &end, 10);
+      o.seed = std::strtoull(v, &end, 10);
     else if (a == "--mesh") {
-      mesh = v;
+      o.mesh = v;
       continue;
     } else if (a == "--beta") {
-      betas.clear();
+      o.betas.clear();
       const char* s = v;
       while (*s) {
-        betas.push_back(std::strtod(s, &end));
-        if (end == s || !(betas.back() > 0.0))
+        o.betas.push_back(std::strtod(s, &end));
+        if (end == s || !(o.betas.back() > 0.0))
           usage("bad --beta list");
         s = *end == ',' ? end + 1 : end;
       }
@@ -90,12 +94,24 @@ int main(int argc, char** argv)
     if (end == v || *end != '\0')
       usage(("bad value of " + a).c_str());
   }
-  if (n < 2)
+  if (o.n < 2)
     usage("--points must be at least 2");
-  if (m == 0)
-    m = n;
-  check = std::min(check, m);
+  if (o.m == 0)
+    o.m = o.n;
+  o.check = std::min(o.check, o.m);
+  return o;
+}
 
+} // namespace
+
+int main(int argc, char** argv)
+{
+  const Options o = parse(argc, argv);
+  const std::size_t n = o.n, m = o.m, check = o.check;
+  const std::vector<double>& betas = o.betas;
+  const double smoothing = o.smoothing;
+  const unsigned long long seed = o.seed;
+  const std::string& mesh = o.mesh;
   // The cloud: positions and true outward normals.
   std::vector<Point_3> points;
   std::vector<Vector_3> normals;

@@ -222,45 +222,47 @@ struct Accepts_core_unary
 };
 
 /// Runs `solver` on `graph`, with the constraints and priors of `in` as
-/// unary terms when there are any (a constraint outweighs all the edges
+/// unary terms when `UserUnary` (a constraint outweighs all the edges
 /// together), and the layer cues `cue` (per point, or empty) added to the
-/// priors; `has_unary` marks the vertices with a unary term.
-template <bool WithUnary, typename Solver, typename Kernel, typename WeightMap, typename LabelMap>
+/// priors when the solver accepts unary terms; `has_unary` marks the
+/// vertices with a unary term.
+template <bool UserUnary, typename Solver, typename Kernel, typename WeightMap, typename LabelMap>
 Solver_report solve_core(const Solver& solver, const Neighbor_graph& graph, WeightMap weight, LabelMap label_map,
                          const Core_points<Kernel>& in, const std::vector<double>& cue, std::vector<char>& has_unary,
                          Orientation_result& result)
 {
-  if constexpr (WithUnary) {
-    typedef std::pair<double, double> Costs;
-    static_assert(Accepts_core_unary<Solver, WeightMap, LabelMap>::value,
-                  "orient_normals: point_is_constrained_map and orientation_prior_map need a solver with "
-                  "solve(graph, weight, unary, labels)");
-    const std::size_t n = in.points.size();
-    double hard = 1.0;
-    typename boost::graph_traits<Neighbor_graph>::edge_iterator eit, eend;
-    for (boost::tie(eit, eend) = edges(graph); eit != eend; ++eit)
-      hard += std::abs(double(get(weight, *eit)));
-    std::vector<Costs> unary(n, Costs(0.0, 0.0));
-    has_unary.assign(n, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-      double a = (in.prior.empty() ? 0.0 : in.prior[i]) + (cue.empty() ? 0.0 : cue[i]); // > 0: keep (label +1)
-      if (!in.constrained.empty() && in.constrained[i])
-        a = hard;
-      if (a != 0.0 && in.normals[i] != CGAL::NULL_VECTOR) {
-        unary[i] = a > 0.0 ? Costs(0.0, a) : Costs(-a, 0.0);
-        has_unary[i] = 1;
-        ++result.number_of_unary_terms;
+  if constexpr (UserUnary || Accepts_core_unary<Solver, WeightMap, LabelMap>::value) {
+    if (UserUnary || !cue.empty()) {
+      typedef std::pair<double, double> Costs;
+      static_assert(Accepts_core_unary<Solver, WeightMap, LabelMap>::value,
+                    "orient_normals: point_is_constrained_map and orientation_prior_map need a solver with "
+                    "solve(graph, weight, unary, labels)");
+      const std::size_t n = in.points.size();
+      double hard = 1.0;
+      typename boost::graph_traits<Neighbor_graph>::edge_iterator eit, eend;
+      for (boost::tie(eit, eend) = edges(graph); eit != eend; ++eit)
+        hard += std::abs(double(get(weight, *eit)));
+      std::vector<Costs> unary(n, Costs(0.0, 0.0));
+      has_unary.assign(n, 0);
+      for (std::size_t i = 0; i < n; ++i) {
+        double a = (in.prior.empty() ? 0.0 : in.prior[i]) + (cue.empty() ? 0.0 : cue[i]); // > 0: keep (label +1)
+        if (!in.constrained.empty() && in.constrained[i])
+          a = hard;
+        if (a != 0.0 && in.normals[i] != CGAL::NULL_VECTOR) {
+          unary[i] = a > 0.0 ? Costs(0.0, a) : Costs(-a, 0.0);
+          has_unary[i] = 1;
+          ++result.number_of_unary_terms;
+        }
       }
+      return solver.solve(graph, weight,
+                          boost::make_iterator_property_map(unary.begin(), get(boost::vertex_index, graph)), label_map);
     }
-    return solver.solve(graph, weight, boost::make_iterator_property_map(unary.begin(), get(boost::vertex_index, graph)),
-                        label_map);
-  } else {
-    (void)in;
-    (void)cue;
-    (void)has_unary;
-    (void)result;
-    return solver.solve(graph, weight, label_map);
   }
+  (void)in;
+  (void)cue;
+  (void)has_unary;
+  (void)result;
+  return solver.solve(graph, weight, label_map);
 }
 
 /// Copies what the graph's construction reports to `result`.
@@ -304,6 +306,21 @@ void core_component_signs(const Neighbor_graph& graph, WeightMap weight, const S
   for (std::size_t i = 0; i < labels.size(); ++i)
     if (flip[component[i]])
       labels[i] = Label(-labels[i]);
+}
+
+/// Negates the normals of `points` whose label in `labels` (in the order of
+/// `points`) is -1; returns how many.  Zero normals are never negated: their
+/// edges weigh 0, so every solver leaves them at +1.
+template <typename PointRange, typename NormalMap>
+std::size_t write_back_signs(PointRange& points, const NormalMap& normal_map, const std::vector<Label>& labels)
+{
+  std::size_t i = 0, flipped = 0;
+  for (auto it = points.begin(); it != points.end(); ++it, ++i)
+    if (labels[i] < 0) {
+      put(normal_map, *it, -get(normal_map, *it));
+      ++flipped;
+    }
+  return flipped;
 }
 
 } // namespace internal
@@ -515,15 +532,8 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         global.dense_samples = dense && !coarse_cloud;
         auto t = std::chrono::steady_clock::now();
         std::fill(labels.begin(), labels.end(), Label(1));
-        Solver_report sr;
-        typedef std::decay_t<decltype(the_solver)> The_solver;
-        if constexpr (internal::Accepts_core_unary<The_solver, decltype(weight), decltype(label_map)>::value) {
-          if (!cue_unary.empty())
-            sr = internal::solve_core<true>(the_solver, graph, weight, label_map, in, cue_unary, has_unary, result);
-        }
-        if (cue_unary.empty())
-          sr = internal::solve_core<has_constraints || has_prior>(the_solver, graph, weight, label_map, in, cue_unary,
-                                                                  has_unary, result);
+        const Solver_report sr = internal::solve_core<has_constraints || has_prior>(
+          the_solver, graph, weight, label_map, in, cue_unary, has_unary, result);
         result.frustrated_edges = sr.frustrated_edges;
         result.number_of_segments = sr.segments;
         const std::vector<char> moved = internal::solver_moves(labels, sr.starting_labels);
@@ -592,14 +602,9 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
     return result;
   }
 
-  // 6. Write back: only the sign changes.
+  // 7. Write back: only the sign changes.
   const auto t_out = std::chrono::steady_clock::now();
-  std::size_t i = 0;
-  for (auto it = points.begin(); it != points.end(); ++it, ++i)
-    if (input_labels[i] < 0) {
-      put(normal_map, *it, -get(normal_map, *it));
-      ++result.number_of_flipped; // zero normals are never flipped: their edges weigh 0
-    }
+  result.number_of_flipped = internal::write_back_signs(points, normal_map, input_labels);
   result.seconds.output = internal::seconds_since(t_out);
   result.seconds.total = internal::seconds_since(t_start);
   return result;

@@ -184,6 +184,63 @@ void output_stages(Labelled_reader& points, const Segment_solution& solution, co
   result.component_files = component_files.files();
 }
 
+/// Stages 3-4: the external sort (unless `settings` says presorted, when
+/// `source` is swept as it is and rewound), then the sweep, which segments
+/// the points into `segmenter`, writes them to `records` and, when `edges`
+/// is not null, each point's earlier edges for the refinement; both files
+/// are rewound.  Fills the sweep's figures of `result`.
+template <typename ConcurrencyTag, typename Kernel, typename Source, typename FlipCriterion, typename Unary>
+Sweep_stage_result sort_and_sweep_stages(Source& source, const Streaming_settings& settings, int axis,
+                                         const Sweep_frame& frame, const FlipCriterion& criterion, const Unary& unary,
+                                         std::uint64_t n, Segmenter& segmenter, Record_file<Swept_record>& records,
+                                         Record_file<Earlier_edge>* edges, Streaming_result& result)
+{
+  using Normal_orientation::internal::seconds_since;
+  const bool presorted = settings.presorted_axis != Presorted_axis::NONE;
+  auto t = std::chrono::steady_clock::now();
+  Sorted_run_reader sorted;
+  if (!presorted) {
+    const Progress_reporter progress = stage_progress(settings.progress, Stage::SORT);
+    progress.report(0, n);
+    Reporting_source<Source> counted(source, progress, n);
+    sorted = external_sort(counted, frame, settings.sort);
+    progress.report(n, n);
+    result.seconds.sort = seconds_since(t);
+  }
+
+  t = std::chrono::steady_clock::now();
+  const Progress_reporter progress = stage_progress(settings.progress, Stage::SWEEP);
+  progress.report(0, n);
+  Sweep_stage_result swept;
+  Segmenting_visitor<ConcurrencyTag, Kernel, FlipCriterion, Unary> visitor(
+    criterion, unary, segmenter, records, edges, result.neighbor_radius, progress, n, swept, settings.layer_edges);
+  Sweep_window<Sweep_payload> window;
+  Sweep_options so;
+  so.number_of_neighbors = settings.number_of_neighbors;
+  so.radius = result.neighbor_radius;
+  so.batch_size = settings.batch_size;
+  const Sweep_report sr =
+    presorted ? sweep<ConcurrencyTag, Kernel>(
+                  source, [axis](const Point_record& r) { return r.position[axis]; }, so, visitor, window)
+              : sweep<ConcurrencyTag, Kernel>(
+                  sorted, [&frame](const Point_record& r) { return frame.key(r); }, so, visitor, window);
+  sorted = Sorted_run_reader(); // removes the sort's files
+  if (presorted)
+    source.rewind();
+  records.rewind();
+  if (edges)
+    edges->rewind();
+  result.number_of_points = sr.number_of_points;
+  result.number_of_edges = sr.number_of_edges;
+  result.peak_window = sr.peak_window;
+  result.edge_span = swept.edge_span;
+  result.energy_before = swept.energy_before;
+  result.number_of_unary_terms = swept.unary_terms;
+  progress.report(n, n);
+  result.seconds.sweep = seconds_since(t);
+  return swept;
+}
+
 /// The stages, run one after the other (see `streaming_orient_normals()`).
 template <typename ConcurrencyTag, typename Kernel, typename Source, typename Sink, typename FlipCriterion,
           typename Solver, typename SignPolicy, typename Unary>
@@ -215,55 +272,17 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   const double radius = result.neighbor_radius;
   unary.hard = 1.0 + double(k) * double(n); // outweighs all the edges together
 
-  // 3. Sort (unless presorted).
-  auto t = Clock::now();
-  Sorted_run_reader sorted;
-  if (!presorted) {
-    const Progress_reporter progress = stage(Stage::SORT);
-    progress.report(0, n);
-    Reporting_source<Source> counted(source, progress, n);
-    sorted = external_sort(counted, frame, settings.sort);
-    progress.report(n, n);
-    result.seconds.sort = seconds_since(t);
-  }
-
-  // 4. Sweep and segmentation.
-  t = Clock::now();
-  const Progress_reporter sweep_progress = stage(Stage::SWEEP);
-  sweep_progress.report(0, n);
+  // 3-4. Sort (unless presorted), sweep and segment.
   Record_file<Swept_record> records(settings.temporary_directory);
   const bool refine = settings.refinement.rounds > 0 && !Unary::enabled;
   std::unique_ptr<Record_file<Earlier_edge>> edges; // for the refinement: each point's earlier edges
   if (refine)
     edges = std::make_unique<Record_file<Earlier_edge>>(settings.temporary_directory, 1 << 16);
   Segmenter segmenter(settings.thresholds);
-  Sweep_stage_result swept;
-  Segmenting_visitor<ConcurrencyTag, Kernel, FlipCriterion, Unary> visitor(
-    phi, unary, segmenter, records, edges.get(), radius, sweep_progress, n, swept, settings.layer_edges);
-  Sweep_window<Sweep_payload> window;
-  Sweep_options so;
-  so.number_of_neighbors = k;
-  so.radius = radius;
-  so.batch_size = settings.batch_size;
-  const Sweep_report sr =
-    presorted ? sweep<ConcurrencyTag, Kernel>(
-                  source, [axis](const Point_record& r) { return r.position[axis]; }, so, visitor, window)
-              : sweep<ConcurrencyTag, Kernel>(
-                  sorted, [&frame](const Point_record& r) { return frame.key(r); }, so, visitor, window);
-  sorted = Sorted_run_reader(); // removes the sort's files
-  if (presorted)
-    source.rewind();
-  records.rewind();
-  if (edges)
-    edges->rewind();
-  result.number_of_points = sr.number_of_points;
-  result.number_of_edges = sr.number_of_edges;
-  result.peak_window = sr.peak_window;
-  result.edge_span = swept.edge_span;
-  result.energy_before = swept.energy_before;
-  result.number_of_unary_terms = swept.unary_terms;
-  sweep_progress.report(n, n);
-  result.seconds.sweep = seconds_since(t);
+  const Sweep_stage_result swept =
+    sort_and_sweep_stages<ConcurrencyTag, Kernel>(source, settings, axis, frame, phi, unary, n, segmenter, records,
+                                                  edges.get(), result);
+  auto t = Clock::now();
 
   // 5-8. The segment graph and its solution, the refinement (skipped when
   // the labelling's energy, known from the segment graph, is negligible:
