@@ -47,8 +47,8 @@ struct Global_samples
   std::vector<std::uint32_t> segment;             ///< final segment
   std::vector<std::uint32_t> component;           ///< component
   std::vector<std::uint32_t> unit;                ///< patch unit (with `Patch_units`)
-  std::vector<char> two_layers;                   ///< on two layers (`Swept_record::two_layers`)
-  std::vector<std::uint16_t> layer;               ///< `Swept_record::two_layers` (`layer_code()`)
+  std::vector<char> two_layers;                   ///< on two layers (`Swept_record::layer` not 0)
+  std::vector<std::uint16_t> layer;               ///< `Swept_record::layer` (`layer_code()`)
   std::vector<signed char> sign;                  ///< the oriented normal over the input normal, +1 or -1
   std::vector<std::uint32_t> sweep_segment;       ///< the sweep's segment (`Swept_record::segment`)
   std::vector<signed char> sweep_flip;            ///< the sweep's flip in it (`Swept_record::flip`)
@@ -105,8 +105,8 @@ Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std
       out.segment.push_back(points.segments()[q]);
       out.component.push_back(c);
       out.unit.push_back(unit);
-      out.two_layers.push_back(char(s.two_layers != 0));
-      out.layer.push_back(s.two_layers);
+      out.two_layers.push_back(char(s.layer != 0));
+      out.layer.push_back(s.layer);
       out.sign.push_back(sign < 0.0 ? -1 : 1);
       out.sweep_segment.push_back(s.segment);
       out.sweep_flip.push_back(s.flip < 0 ? -1 : 1);

@@ -41,11 +41,11 @@ struct Swept_record
   Point_record record;
   std::uint32_t segment;
   std::int16_t flip;
-  std::uint16_t two_layers;
+  std::uint16_t layer; ///< `layer_code()`: 0 on one layer
 };
 
 /// The layer offset `t` of a point of unit normal `u` (zero: one layer),
-/// coded in 16 bits for `Swept_record::two_layers`: 0 on one layer; else bit
+/// coded in 16 bits for `Swept_record::layer`: 0 on one layer; else bit
 /// 15 set when the other layer lies along u, and bits 0-14 the gap |t| in
 /// units of `radius` / 32767 (at least 1).  `layer_code_offset()` reads it
 /// back along u: the fit's line is within a few degrees of the normal line.
