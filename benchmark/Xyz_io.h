@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -252,6 +253,69 @@ inline bool read_oriented_and_truth(const std::string& oriented_path, const std:
     return false;
   }
   return true;
+}
+
+/// The command line of a program that reads an oriented cloud and its truth:
+/// the two files, and whether `--json` was given.
+struct Oriented_and_truth_command
+{
+  std::string oriented, truth;
+  bool json = false;
+};
+
+/**
+ * \brief Parses the command line of a program that reads an oriented cloud and its truth, then
+ * reads both files (`read_oriented_and_truth()`).
+ *
+ * `-h` or `--help` prints `usage` to stdout and exits with 0. `--json` sets `json`. Every other
+ * argument starting with '-' goes to `option(argument, i)`, which returns `true` when it took it
+ * (and may step `i` over its value; a bad value is for it to report, exiting with 2). An option
+ * it does not take, or a count of files other than two, prints the usage to stderr and exits
+ * with 2; a file that cannot be read or does not match prints `program: reason` and exits with 1.
+ */
+template <typename Option>
+Oriented_and_truth_command read_oriented_and_truth_command(int argc, char** argv, const char* program,
+                                                           void (*usage)(std::FILE*), Option option,
+                                                           std::vector<Xyz_row>& oriented, std::vector<Xyz_row>& truth)
+{
+  Oriented_and_truth_command c;
+  std::vector<std::string> files;
+  for(int i = 1; i < argc; ++i)
+  {
+    const std::string arg = argv[i];
+    if(arg == "-h" || arg == "--help")
+    {
+      usage(stdout);
+      std::exit(0);
+    }
+    if(arg == "--json")
+      c.json = true;
+    else if(!arg.empty() && arg[0] == '-' && arg != "-")
+    {
+      if(!option(arg, i))
+      {
+        std::fprintf(stderr, "%s: unknown option '%s'\n", program, arg.c_str());
+        usage(stderr);
+        std::exit(2);
+      }
+    }
+    else
+      files.push_back(arg);
+  }
+  if(files.size() != 2)
+  {
+    usage(stderr);
+    std::exit(2);
+  }
+  c.oriented = files[0];
+  c.truth = files[1];
+  std::string error;
+  if(!read_oriented_and_truth(c.oriented, c.truth, oriented, truth, error))
+  {
+    std::fprintf(stderr, "%s: %s\n", program, error.c_str());
+    std::exit(1);
+  }
+  return c;
 }
 
 } // namespace benchmark

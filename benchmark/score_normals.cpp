@@ -85,41 +85,12 @@ Score score(const std::vector<Xyz_row>& oriented, const std::vector<Xyz_row>& tr
 /// Entry point: see print_usage().
 int main(int argc, char** argv)
 {
-  bool json = false;
-  std::vector<std::string> positional;
-  for(int i = 1; i < argc; ++i)
-  {
-    const std::string arg = argv[i];
-    if(arg == "-h" || arg == "--help")
-    {
-      print_usage(stdout);
-      return EXIT_SUCCESS;
-    }
-    else if(arg == "--json")
-      json = true;
-    else if(!arg.empty() && arg[0] == '-' && arg != "-")
-    {
-      std::fprintf(stderr, "score_normals: unknown option '%s'\n", arg.c_str());
-      print_usage(stderr);
-      return 2;
-    }
-    else
-      positional.push_back(arg);
-  }
-  if(positional.size() != 2)
-  {
-    print_usage(stderr);
-    return 2;
-  }
-
   const auto start = std::chrono::steady_clock::now();
   std::vector<Xyz_row> oriented, truth;
-  std::string error;
-  if(!Normal_orientation::benchmark::read_oriented_and_truth(positional[0], positional[1], oriented, truth, error))
-  {
-    std::fprintf(stderr, "score_normals: %s\n", error.c_str());
-    return EXIT_FAILURE;
-  }
+  const bool json = Normal_orientation::benchmark::read_oriented_and_truth_command(
+                      argc, argv, "score_normals", print_usage, [](const std::string&, int&) { return false; },
+                      oriented, truth)
+                      .json;
   const Score s = score(oriented, truth);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 

@@ -115,51 +115,25 @@ bool parse_ks(const std::string& text, std::vector<unsigned int>& ks)
 /// Entry point: see print_usage().
 int main(int argc, char** argv)
 {
-  bool json = false;
   std::vector<unsigned int> ks = {24, 48, 96};
-  std::vector<std::string> positional;
-  for(int i = 1; i < argc; ++i)
-  {
-    const std::string arg = argv[i];
-    if(arg == "-h" || arg == "--help")
+  auto option = [&](const std::string& arg, int& i) {
+    if(arg != "--k")
+      return false;
+    if(i + 1 >= argc || !parse_ks(argv[++i], ks))
     {
-      print_usage(stdout);
-      return EXIT_SUCCESS;
+      std::fprintf(stderr, "sign_floor: --k takes a list of neighbour counts of at least 3, like 24,48\n");
+      std::exit(2);
     }
-    if(arg == "--json")
-      json = true;
-    else if(arg == "--k")
-    {
-      if(i + 1 >= argc || !parse_ks(argv[++i], ks))
-      {
-        std::fprintf(stderr, "sign_floor: --k takes a list of neighbour counts of at least 3, like 24,48\n");
-        return 2;
-      }
-    }
-    else if(!arg.empty() && arg[0] == '-' && arg != "-")
-    {
-      std::fprintf(stderr, "sign_floor: unknown option '%s'\n", arg.c_str());
-      print_usage(stderr);
-      return 2;
-    }
-    else
-      positional.push_back(arg);
-  }
-  if(positional.size() != 2)
-  {
-    print_usage(stderr);
-    return 2;
-  }
+    return true;
+  };
   std::vector<Xyz_row> cloud, truth;
-  std::string error;
-  if(!Normal_orientation::benchmark::read_oriented_and_truth(positional[0], positional[1], cloud, truth, error))
-  {
-    std::fprintf(stderr, "sign_floor: %s\n", error.c_str());
-    return EXIT_FAILURE;
-  }
+  const Normal_orientation::benchmark::Oriented_and_truth_command command =
+    Normal_orientation::benchmark::read_oriented_and_truth_command(argc, argv, "sign_floor", print_usage, option,
+                                                                   cloud, truth);
+  const bool json = command.json;
   if(cloud.size() < 3)
   {
-    std::fprintf(stderr, "sign_floor: '%s' has fewer than 3 points\n", positional[0].c_str());
+    std::fprintf(stderr, "sign_floor: '%s' has fewer than 3 points\n", command.oriented.c_str());
     return EXIT_FAILURE;
   }
   for(unsigned int k : ks)

@@ -57,51 +57,23 @@ double energy_per_area(const std::vector<Kernel::Point_3>& points, const std::ve
 /// Entry point: see print_usage().
 int main(int argc, char** argv)
 {
-  bool json = false;
   long long stride = 0;
-  std::vector<std::string> positional;
-  for(int i = 1; i < argc; ++i)
-  {
-    const std::string arg = argv[i];
-    if(arg == "-h" || arg == "--help")
+  auto option = [&](const std::string& arg, int& i) {
+    if(arg != "--stride" || i + 1 >= argc)
+      return false;
+    char* end = nullptr;
+    stride = std::strtoll(argv[++i], &end, 10);
+    if(end == argv[i] || *end != '\0' || stride < 1)
     {
-      print_usage(stdout);
-      return EXIT_SUCCESS;
+      std::fprintf(stderr, "winding_energy: --stride needs a whole number >= 1, not '%s'\n", argv[i]);
+      std::exit(2);
     }
-    else if(arg == "--json")
-      json = true;
-    else if(arg == "--stride" && i + 1 < argc)
-    {
-      char* end = nullptr;
-      stride = std::strtoll(argv[++i], &end, 10);
-      if(end == argv[i] || *end != '\0' || stride < 1)
-      {
-        std::fprintf(stderr, "winding_energy: --stride needs a whole number >= 1, not '%s'\n", argv[i]);
-        return 2;
-      }
-    }
-    else if(!arg.empty() && arg[0] == '-')
-    {
-      std::fprintf(stderr, "winding_energy: unknown option '%s'\n", arg.c_str());
-      print_usage(stderr);
-      return 2;
-    }
-    else
-      positional.push_back(arg);
-  }
-  if(positional.size() != 2)
-  {
-    print_usage(stderr);
-    return 2;
-  }
-
+    return true;
+  };
   std::vector<Xyz_row> oriented, truth;
-  std::string error;
-  if(!Normal_orientation::benchmark::read_oriented_and_truth(positional[0], positional[1], oriented, truth, error))
-  {
-    std::fprintf(stderr, "winding_energy: %s\n", error.c_str());
-    return EXIT_FAILURE;
-  }
+  const bool json = Normal_orientation::benchmark::read_oriented_and_truth_command(
+                      argc, argv, "winding_energy", print_usage, option, oriented, truth)
+                      .json;
 
   const std::size_t n = truth.size();
   if(stride == 0)
