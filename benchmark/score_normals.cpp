@@ -8,6 +8,7 @@
 // true normal is <= 0. The score is given over all normals and over the "clear" normals, whose
 // line is within 60 degrees of the true normal's line (|cos| >= 0.5): only there does the sign
 // of a normal mean something. Zero and non-finite normals are wrong, in both counts.
+#include "Normal_score.h"
 #include "Xyz_io.h"
 
 #include <chrono>
@@ -20,7 +21,9 @@
 
 namespace {
 
+using Normal_orientation::benchmark::Normal_score;
 using Normal_orientation::benchmark::Xyz_row;
+using Normal_orientation::benchmark::percent;
 
 /// Prints the usage message to `out`.
 void print_usage(std::FILE* out)
@@ -35,48 +38,12 @@ void print_usage(std::FILE* out)
                "  Exit status: 0 scored, 1 unreadable or mismatched files, 2 bad usage.\n");
 }
 
-/// The counts of one scoring.
-struct Score
-{
-  std::size_t points = 0;      ///< normals scored
-  std::size_t wrong = 0;       ///< dot with the truth <= 0, or invalid
-  std::size_t clear = 0;       ///< |cos| >= 0.5, or invalid
-  std::size_t clear_wrong = 0; ///< wrong among the clear ones
-  std::size_t invalid = 0;     ///< zero or non-finite normals
-};
-
-/// Returns `100 * part / whole`, or 0 when `whole` is 0.
-double percent(std::size_t part, std::size_t whole)
-{
-  return whole == 0 ? 0.0 : 100.0 * double(part) / double(whole);
-}
-
 /// Scores `oriented` against `truth` (same size, checked before).
-Score score(const std::vector<Xyz_row>& oriented, const std::vector<Xyz_row>& truth)
+Normal_score score(const std::vector<Xyz_row>& oriented, const std::vector<Xyz_row>& truth)
 {
-  Score s;
-  s.points = truth.size();
+  Normal_score s;
   for(std::size_t i = 0; i < truth.size(); ++i)
-  {
-    const double* n = &oriented[i][3];
-    const double* g = &truth[i][3];
-    const double dot = n[0] * g[0] + n[1] * g[1] + n[2] * g[2];
-    const double lengths = std::sqrt((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]));
-    const bool valid = std::isfinite(dot) && std::isfinite(lengths) && lengths > 0.0;
-    if(!valid)
-    {
-      ++s.invalid;
-      ++s.wrong;
-      ++s.clear;
-      ++s.clear_wrong;
-      continue;
-    }
-    const bool wrong = !(dot > 0.0);
-    const bool clear = std::fabs(dot) >= 0.5 * lengths;
-    s.wrong += wrong ? 1 : 0;
-    s.clear += clear ? 1 : 0;
-    s.clear_wrong += (clear && wrong) ? 1 : 0;
-  }
+    s.add(&oriented[i][3], &truth[i][3]);
   return s;
 }
 
@@ -91,7 +58,7 @@ int main(int argc, char** argv)
                       argc, argv, "score_normals", print_usage, [](const std::string&, int&) { return false; },
                       oriented, truth)
                       .json;
-  const Score s = score(oriented, truth);
+  const Normal_score s = score(oriented, truth);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 
   if(json)

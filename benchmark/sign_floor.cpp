@@ -11,6 +11,7 @@
 // perpendicular to the surface, where the noise is wider than the spacing. The counts are those
 // of score_normals (wrong: dot with the truth <= 0; clear: the line within 60 degrees of the
 // truth's).
+#include "Normal_score.h"
 #include "Xyz_io.h"
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -33,7 +34,9 @@ typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
 typedef Kernel::Point_3 Point_3;
 typedef Kernel::Vector_3 Vector_3;
 typedef std::pair<Point_3, Vector_3> Point_with_normal;
+using Normal_orientation::benchmark::Normal_score;
 using Normal_orientation::benchmark::Xyz_row;
+using Normal_orientation::benchmark::percent;
 
 /// Prints the usage message to `out`.
 void print_usage(std::FILE* out)
@@ -49,13 +52,8 @@ void print_usage(std::FILE* out)
                "  Exit status: 0 done, 1 unreadable or mismatched files, 2 bad usage.\n");
 }
 
-/// The wrong counts after the signs of the coarse normals of `k` neighbours.
-struct Floor
-{
-  std::size_t wrong = 0, clear = 0, clear_wrong = 0;
-};
-
-Floor floor_at(const std::vector<Xyz_row>& cloud, const std::vector<Xyz_row>& truth, unsigned int k)
+/// The scores after the signs of the coarse normals of `k` neighbours.
+Normal_score floor_at(const std::vector<Xyz_row>& cloud, const std::vector<Xyz_row>& truth, unsigned int k)
 {
   std::vector<Point_with_normal> points(cloud.size());
   for(std::size_t i = 0; i < cloud.size(); ++i)
@@ -64,7 +62,7 @@ Floor floor_at(const std::vector<Xyz_row>& cloud, const std::vector<Xyz_row>& tr
     points, k,
     CGAL::parameters::point_map(CGAL::First_of_pair_property_map<Point_with_normal>())
       .normal_map(CGAL::Second_of_pair_property_map<Point_with_normal>()));
-  Floor f;
+  Normal_score f;
   for(std::size_t i = 0; i < cloud.size(); ++i)
   {
     const double* n = &cloud[i][3];
@@ -72,21 +70,11 @@ Floor floor_at(const std::vector<Xyz_row>& cloud, const std::vector<Xyz_row>& tr
     const Vector_3& c = points[i].second;
     const double cg = c.x() * g[0] + c.y() * g[1] + c.z() * g[2];
     const double nc = (n[0] * c.x() + n[1] * c.y() + n[2] * c.z()) * (cg < 0.0 ? -1.0 : 1.0);
-    const double ng = (n[0] * g[0] + n[1] * g[1] + n[2] * g[2]) * (nc < 0.0 ? -1.0 : 1.0);
-    const double lengths = std::sqrt((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) * (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]));
-    const bool valid = std::isfinite(ng) && std::isfinite(lengths) && lengths > 0.0;
-    const bool wrong = !valid || !(ng > 0.0);
-    const bool clear = !valid || std::fabs(ng) >= 0.5 * lengths;
-    f.wrong += wrong ? 1 : 0;
-    f.clear += clear ? 1 : 0;
-    f.clear_wrong += (clear && wrong) ? 1 : 0;
+    const double s = nc < 0.0 ? -1.0 : 1.0;
+    const double signed_normal[3] = {s * n[0], s * n[1], s * n[2]};
+    f.add(signed_normal, g);
   }
   return f;
-}
-
-double percent(std::size_t part, std::size_t whole)
-{
-  return whole == 0 ? 0.0 : 100.0 * double(part) / double(whole);
 }
 
 /// Parses "K1,K2,..." (each at least 3) into `ks`; false when malformed.
@@ -139,7 +127,7 @@ int main(int argc, char** argv)
   for(unsigned int k : ks)
   {
     const unsigned int kk = static_cast<unsigned int>(std::min<std::size_t>(k, cloud.size()));
-    const Floor f = floor_at(cloud, truth, kk);
+    const Normal_score f = floor_at(cloud, truth, kk);
     if(json)
       std::printf("{\"k\":%u,\"points\":%zu,\"wrong\":%zu,\"wrong_percent\":%.4f,\"clear\":%zu,\"clear_wrong\":%zu}\n",
                   kk, cloud.size(), f.wrong, percent(f.wrong, cloud.size()), f.clear, f.clear_wrong);
