@@ -370,6 +370,23 @@ TEST(Unary_terms, EnergyInTheReportIncludesTheUnaryCosts)
   EXPECT_THROW(solve_unary(NO::Lsa_tr_solver(), pair, bad, l), std::invalid_argument);
 }
 
+TEST(Solvers, RefuseNonFiniteWeights)
+{
+  for (double bad : {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    Ugraph g(3);
+    boost::add_edge(0, 1, 1.0, g);
+    boost::add_edge(1, 2, bad, g);
+    std::vector<NO::Label> l;
+    NO::Qpbo_i_solver reduced;
+    reduced.reduction_threshold = 0;
+    EXPECT_THROW(solve(NO::Mst_solver(), g, l), std::invalid_argument);
+    EXPECT_THROW(solve(NO::Mst_solver(0), g, l), std::invalid_argument);
+    EXPECT_THROW(solve(NO::Qpbo_i_solver(), g, l), std::invalid_argument);
+    EXPECT_THROW(solve(reduced, g, l), std::invalid_argument);
+    EXPECT_THROW(solve(NO::Lsa_tr_solver(), g, l), std::invalid_argument);
+  }
+}
+
 TEST(Unary_terms, NeverAboveMstNeverBelowOptimum)
 {
   std::mt19937_64 rng(33);
@@ -662,6 +679,13 @@ TEST(Segment_reduction, ReducedQpboINeverAboveMstAndHonoursConstraints)
     const double mst = solve(NO::Mst_solver(), g, a);
     const NO::Solver_report r = solve_report(reduced, g, b);
     ASSERT_LE(r.energy, mst + 1e-9) << "trial " << t;
+    // the reported energy and frustration are those of the labels written
+    const auto w = get(boost::edge_weight, g);
+    ASSERT_EQ(r.energy, NO::energy(g, w, CGAL::make_property_map(b)));
+    std::size_t frustrated = 0;
+    for (auto e : boost::make_iterator_range(edges(g)))
+      frustrated += NO::edge_energy(get(w, e), b[source(e, g)], b[target(e, g)]) > 0.0 ? 1 : 0;
+    ASSERT_EQ(r.frustrated_edges, frustrated);
     ASSERT_GT(r.segments, 0u);
     ASSERT_LT(r.segments, 3000u);
     ASSERT_EQ(solve(reduced, g, c), r.energy); // deterministic

@@ -22,9 +22,11 @@
 #include <boost/property_map/property_map.hpp>
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -138,16 +140,19 @@ std::size_t connected_components(const Graph& g, WeightMap weight, std::vector<s
 /// \cond SKIP_IN_MANUAL
 namespace internal {
 
-/// Writes `best` (one label per vertex index) to `labels`; returns the
-/// energy of `best` and the number of edges whose wish it does not meet.
-template <typename Graph, typename WeightMap, typename LabelMap>
-std::pair<double, std::size_t> write_labels(const Graph& g, WeightMap weight, const std::vector<Label>& best,
-                                            LabelMap labels)
+/// The tag that stands for "no unary terms" in the solvers' implementations.
+struct No_unary
+{};
+
+/// The energy of `best` (one label per vertex index) on `g`, with the unary
+/// terms `unary` unless `UnaryMap` is `No_unary` (the value of `energy()`,
+/// summed in the same order), and the number of edges whose wish it does
+/// not meet.
+template <typename Graph, typename WeightMap, typename UnaryMap>
+std::pair<double, std::size_t> labelling_energy(const Graph& g, WeightMap weight, const UnaryMap& unary,
+                                                const std::vector<Label>& best)
 {
   auto index = get(boost::vertex_index, g);
-  typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
-  for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit)
-    put(labels, *vit, best[std::size_t(get(index, *vit))]);
   double e = 0.0;
   std::size_t frustrated = 0;
   typename boost::graph_traits<Graph>::edge_iterator it, end;
@@ -157,30 +162,36 @@ std::pair<double, std::size_t> write_labels(const Graph& g, WeightMap weight, co
     e += term;
     frustrated += term > 0.0 ? 1 : 0;
   }
+  if constexpr (!std::is_same<UnaryMap, No_unary>::value) {
+    typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
+    for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit) {
+      const auto& costs = get(unary, *vit);
+      e += best[std::size_t(get(index, *vit))] > 0 ? double(costs.first) : double(costs.second);
+    }
+  } else
+    (void)unary;
   return {e, frustrated};
 }
 
-/// Writes `best` (one label per vertex index) to `labels`; returns the
-/// energy of `best` with the unary terms `unary` (the value of
-/// `energy(g, weight, unary, labels)`, summed in the same order) and the
-/// number of edges whose wish it does not meet.
-template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
-std::pair<double, std::size_t> write_labels(const Graph& g, WeightMap weight, UnaryMap unary,
-                                            const std::vector<Label>& best, LabelMap labels)
+/// Writes `best` (one label per vertex index) to `labels`.
+template <typename Graph, typename LabelMap>
+void put_labels(const Graph& g, const std::vector<Label>& best, LabelMap labels)
 {
-  std::pair<double, std::size_t> result = write_labels(g, weight, best, labels);
   auto index = get(boost::vertex_index, g);
   typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
-  for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit) {
-    const auto& costs = get(unary, *vit);
-    result.first += best[std::size_t(get(index, *vit))] > 0 ? double(costs.first) : double(costs.second);
-  }
-  return result;
+  for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit)
+    put(labels, *vit, best[std::size_t(get(index, *vit))]);
 }
 
-/// The tag that stands for "no unary terms" in the solvers' implementations.
-struct No_unary
-{};
+/// Writes `best` (one label per vertex index) to `labels`; returns
+/// `labelling_energy(g, weight, unary, best)`.
+template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
+std::pair<double, std::size_t> write_labels(const Graph& g, WeightMap weight, const UnaryMap& unary,
+                                            const std::vector<Label>& best, LabelMap labels)
+{
+  put_labels(g, best, labels);
+  return labelling_energy(g, weight, unary, best);
+}
 
 /// Returns the unary costs of `unary` by vertex index: `first` the cost of
 /// label +1, `second` the cost of label -1.

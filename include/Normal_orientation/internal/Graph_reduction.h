@@ -121,6 +121,9 @@ struct Incidence
   /// the signed weight of each incident edge
   std::vector<float> weight;
 
+  /// no vertices (an object to assign lists to)
+  Incidence() : first(1, 0) {}
+
   /// the incidence lists of `p`
   explicit Incidence(const Array_problem& p)
   {

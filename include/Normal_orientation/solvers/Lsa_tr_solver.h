@@ -198,10 +198,7 @@ private:
     std::vector<Label> best(n);
     for (std::size_t i = 0; i < n; ++i)
       best[i] = z[i] ? Label(-y[i]) : y[i];
-    if constexpr (with_unary)
-      std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, unary, best, labels);
-    else
-      std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, best, labels);
+    std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, unary, best, labels);
     report.starting_labels = std::move(y);
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;

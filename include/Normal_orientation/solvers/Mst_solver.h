@@ -9,6 +9,7 @@
 
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Signed_union_find.h>
+#include <Normal_orientation/internal/Graph_reduction.h>
 #include <Normal_orientation/solvers/Orientation_solver_base.h>
 #include <Normal_orientation/solvers/Solver_report.h>
 
@@ -22,6 +23,7 @@
 #include <cstring>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -46,10 +48,10 @@ namespace Normal_orientation {
 /// (see `Component_sign.h`); vertices without edges get +1.
 ///
 /// After the forest, `local_sweeps` sweeps of single-vertex moves follow
-/// (iterated conditional modes): in vertex order, a vertex flips when the
-/// edges at it weigh more against its label than for it.  A move never
-/// raises the energy (up to the single-precision rounding of the weights
-/// used for ranking), and all the edges at a vertex vote, where the forest
+/// (iterated conditional modes, `internal::improve_by_sweeps()`): in vertex
+/// order, a vertex flips when the edges at it (in single precision) weigh
+/// more against its label than for it.  A move never raises the energy (up
+/// to that rounding), and all the edges at a vertex vote, where the forest
 /// listened to one; on the benchmark clouds this removes about 5% of the
 /// wrong normals left by the forest, and it finds the optimum of the
 /// paper's Figure 2 example.  With `local_sweeps = 0` the solver is
@@ -63,8 +65,8 @@ namespace Normal_orientation {
 /// are ranked with the others (after the edges of `g` of the same rank) and
 /// the same algorithm runs on the n + 1 vertices; then, if the ground came
 /// out -1, every vertex of its tree flips (which does not change the energy
-/// of the tree's edges), and the sweeps never move the ground but count its
-/// edges at every other vertex.  So a vertex whose unary cost difference
+/// of the tree's edges), and the sweeps add c- - c+ to the weight of the
+/// edges for label +1 at every vertex.  So a vertex whose unary cost difference
 /// exceeds the sum of the |w| of its edges ends with its cheaper label (up
 /// to the single-precision rounding of the ranks and sweeps);
 /// conflicting constraints are decided by the forest, strongest first.
@@ -76,13 +78,14 @@ namespace Normal_orientation {
 /// `Solver_report::energy` includes the unary costs,
 /// `Solver_report::iterations` counts the ground edges too, and
 /// `Solver_report::tree_edges` and `Solver_report::frustrated_edges` count
-/// the edges of `g` only.  Throws `std::invalid_argument` if a unary cost is
-/// not finite.
+/// the edges of `g` only.  Throws `std::invalid_argument` if an edge weight
+/// or a unary cost is not finite.
 ///
 /// Cost: O(E) for the sort (radix), then O(E alpha(V)), then O(E) per sweep.
-/// Memory: about 24 bytes per edge and 7 bytes per vertex during the solve
-/// (with unary terms: plus about 40 bytes per vertex whose two costs
-/// differ, and 16 bytes per vertex while the costs are read).
+/// Memory: about 24 bytes per edge during the sort, 12 per edge and 7 per
+/// vertex during the forest, then 16 per edge and 5 per vertex during the
+/// sweeps; with unary terms, plus 8 bytes per vertex (24 while the costs
+/// are read), and the edges to the ground count as edges.
 /// \cgalModels `OrientationSolver`
 class Mst_solver : public Orientation_solver_base<Mst_solver>
 {
@@ -100,6 +103,7 @@ public:
 private:
   /// \cond SKIP_IN_MANUAL
   friend class Orientation_solver_base<Mst_solver>; // calls solve_impl()
+  friend class Qpbo_i_solver;                       // keeps the incidence lists (solve_forest())
   /// \endcond
 
   /// the top bit of `Sorted_edge::head`: the weight is negative
@@ -121,74 +125,83 @@ private:
     return {~bits, u, v | (w < 0.0 ? negative_bit : 0u)};
   }
 
-  /// The solve, without unary terms when `UnaryMap` is `internal::No_unary`
-  /// (then vertex n, the ground, does not exist).
+  /// The solve, without unary terms when `UnaryMap` is `internal::No_unary`.
   template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
   Solver_report solve_impl(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels) const
   {
-    constexpr bool with_unary = !std::is_same<UnaryMap, internal::No_unary>::value;
-    const auto start = std::chrono::steady_clock::now();
-    typedef typename boost::graph_traits<Graph>::edge_iterator edge_iterator;
+    return solve_forest(g, weight, unary, labels, nullptr);
+  }
+
+  /// The informative edges of `g` (and, with unary terms, the edges to the
+  /// ground vertex n of weight `preference[i]`), sorted by decreasing |w|
+  /// rounded to single precision, ties in the order of `edges(g)`.
+  template <typename Graph, typename WeightMap>
+  static std::vector<Sorted_edge> sorted_edges(const Graph& g, WeightMap weight,
+                                               const std::vector<double>& preference)
+  {
+    // 1. A 32-bit sort key per edge: the complement of |w| as float bits, so
+    //    that larger |w| comes first.  The sign of w is kept in the top bit
+    //    of the head.  The ends travel with the key, so the Kruskal loop
+    //    reads the edges sequentially.
     const std::size_t n = num_vertices(g);
     auto index = get(boost::vertex_index, g);
+    std::vector<Sorted_edge> sorted;
+    sorted.reserve(std::size_t(num_edges(g)) + preference.size());
+    typename boost::graph_traits<Graph>::edge_iterator it, end;
+    for (boost::tie(it, end) = edges(g); it != end; ++it) {
+      const double w = double(get(weight, *it));
+      if (!std::isfinite(w))
+        throw std::invalid_argument("Mst_solver: an edge weight is not finite");
+      const std::size_t u = std::size_t(get(index, source(*it, g)));
+      const std::size_t v = std::size_t(get(index, target(*it, g)));
+      if (w != 0.0 && u != v) // zero weights carry no information
+        sorted.push_back(make_sorted_edge(w, std::uint32_t(u), std::uint32_t(v)));
+    }
+    for (std::size_t i = 0; i < preference.size(); ++i)
+      if (preference[i] != 0.0)
+        sorted.push_back(make_sorted_edge(preference[i], std::uint32_t(i), std::uint32_t(n)));
+    // 2. A stable least-significant-digit radix sort on the key, two 16-bit
+    //    digits: the order is fully determined, whatever the number of
+    //    threads.
+    std::vector<Sorted_edge> buffer(sorted.size());
+    std::vector<std::size_t> bucket_start(std::size_t(1) << 16);
+    for (int shift = 0; shift < 32; shift += 16) {
+      std::fill(bucket_start.begin(), bucket_start.end(), std::size_t(0));
+      for (const Sorted_edge& e : sorted)
+        ++bucket_start[(e.key >> shift) & 0xffffu];
+      std::size_t sum = 0;
+      for (std::size_t& c : bucket_start) {
+        const std::size_t count = c;
+        c = sum;
+        sum += count;
+      }
+      for (const Sorted_edge& e : sorted)
+        buffer[bucket_start[(e.key >> shift) & 0xffffu]++] = e;
+      sorted.swap(buffer);
+    }
+    return sorted;
+  }
 
-    // 1. Gather the informative edges with a 32-bit sort key: the
-    //    complement of |w| as float bits, so that larger |w| comes first.
-    //    The sign of w is kept in the top bit of the head.  The ends travel
-    //    with the key, so the Kruskal loop below reads the edges
-    //    sequentially.
+  /// The solve; with `incidence` not null, the incidence lists of (`g`,
+  /// `weight`) that the sweeps ran on are left in `*incidence` (built even
+  /// without sweeps), for a caller that sweeps again.
+  template <typename Graph, typename WeightMap, typename UnaryMap, typename LabelMap>
+  Solver_report solve_forest(const Graph& g, WeightMap weight, UnaryMap unary, LabelMap labels,
+                             internal::Incidence* incidence) const
+  {
+    constexpr bool with_unary = !std::is_same<UnaryMap, internal::No_unary>::value;
+    const auto start = std::chrono::steady_clock::now();
+    const std::size_t n = num_vertices(g);
     if (n + (with_unary ? 1 : 0) >= std::size_t(negative_bit))
       throw std::length_error(with_unary ? "Mst_solver: more than 2^31 - 2 vertices with unary terms"
                                          : "Mst_solver: more than 2^31 - 1 vertices");
-    std::vector<Sorted_edge> sorted;
-    sorted.reserve(std::size_t(num_edges(g)) + (with_unary ? n : 0));
-    edge_iterator it, end;
-    for (boost::tie(it, end) = edges(g); it != end; ++it) {
-      const double w = double(get(weight, *it));
-      if (!(w != 0.0))
-        continue; // zero (or NaN) weights carry no information
-      const std::size_t u = std::size_t(get(index, source(*it, g)));
-      const std::size_t v = std::size_t(get(index, target(*it, g)));
-      if (u == v)
-        continue;
-      sorted.push_back(make_sorted_edge(w, std::uint32_t(u), std::uint32_t(v)));
-    }
     // With unary terms, the costs (c+, c-) of vertex i are the constant
     // min(c+, c-) plus edge_energy(c- - c+, L_i, L_n) with the ground vertex
     // n labelled +1: an edge of signed weight c- - c+ from i to n.
-    const std::uint32_t ground = std::uint32_t(n);
-    if constexpr (with_unary) {
-      const std::vector<std::pair<double, double>> costs = internal::unary_costs(g, unary, "Mst_solver");
-      for (std::size_t i = 0; i < n; ++i) {
-        const double w = costs[i].second - costs[i].first;
-        if (w != 0.0)
-          sorted.push_back(make_sorted_edge(w, std::uint32_t(i), ground));
-      }
-    } else
-      (void)unary;
+    const std::vector<double> preference = internal::unary_preferences(g, unary, "Mst_solver");
+    std::vector<Sorted_edge> sorted = sorted_edges(g, weight, preference);
     const std::size_t vertex_count = n + (with_unary ? 1 : 0);
-
-    // 2. Sort by decreasing |w|, ties in the order of edges(g): a stable
-    //    least-significant-digit radix sort on the key, two 16-bit digits.
-    //    The order is fully determined, whatever the number of threads.
-    {
-      std::vector<Sorted_edge> buffer(sorted.size());
-      std::vector<std::size_t> bucket_start(std::size_t(1) << 16);
-      for (int shift = 0; shift < 32; shift += 16) {
-        std::fill(bucket_start.begin(), bucket_start.end(), std::size_t(0));
-        for (const Sorted_edge& e : sorted)
-          ++bucket_start[(e.key >> shift) & 0xffffu];
-        std::size_t sum = 0;
-        for (std::size_t& c : bucket_start) {
-          const std::size_t count = c;
-          c = sum;
-          sum += count;
-        }
-        for (const Sorted_edge& e : sorted)
-          buffer[bucket_start[(e.key >> shift) & 0xffffu]++] = e;
-        sorted.swap(buffer);
-      }
-    }
+    const std::uint32_t ground = std::uint32_t(n);
 
     // 3. Kruskal with orientation propagation on the signed union-find.
     Signed_union_find uf(vertex_count);
@@ -202,96 +215,36 @@ private:
       if ((su != sv) != ((e.head & negative_bit) != 0))
         uf.flip_root(rv);
       uf.unite_roots(ru, rv);
-      if constexpr (with_unary)
-        report.tree_edges += (v != ground);
-      else
-        ++report.tree_edges;
+      report.tree_edges += (!with_unary || v != ground) ? 1 : 0;
     }
     report.iterations = sorted.size();
+    std::vector<Sorted_edge>().swap(sorted);
 
-    // 4. Labels, then energy and frustrated edges in one pass.  With unary
-    //    terms the ground must be +1: its tree is flipped if needed (the
-    //    energy of a tree does not change when all its labels flip).
+    // 4. Labels.  With unary terms the ground must be +1: its tree is
+    //    flipped if needed (the energy of a tree does not change when all
+    //    its labels flip).
     std::vector<Label> label(vertex_count);
     for (std::size_t i = 0; i < vertex_count; ++i)
       label[i] = Label(uf.sign(std::uint32_t(i)) ? -1 : 1);
-    if constexpr (with_unary) {
-      if (label[ground] < 0) {
-        const auto ground_root = uf.find(ground);
-        for (std::size_t i = 0; i < vertex_count; ++i)
-          if (uf.find(std::uint32_t(i)) == ground_root)
-            label[i] = Label(-label[i]);
-      }
-    }
-    // the sweeps never move the ground (vertex n), but see its edges
-    if (local_sweeps > 0)
-      report.iterations += improve_vertices(vertex_count, n, sorted, label);
-    typename boost::graph_traits<Graph>::vertex_iterator vit, vend;
-    for (boost::tie(vit, vend) = vertices(g); vit != vend; ++vit)
-      put(labels, *vit, label[std::size_t(get(index, *vit))]);
-    for (const Sorted_edge& e : sorted) {
-      const bool negative = (e.head & negative_bit) != 0;
-      const std::uint32_t v = e.head & ~negative_bit;
-      if constexpr (with_unary)
-        if (v == ground)
-          continue;
-      if ((label[e.tail] == label[v]) == negative)
-        ++report.frustrated_edges;
-    }
-    return internal::complete_report(report, g, weight, unary, labels, start);
-  }
-
-  /// the signed weight of `e`, as ranked (single precision)
-  static float signed_weight(const Sorted_edge& e)
-  {
-    const std::uint32_t bits = ~e.key;
-    float a;
-    std::memcpy(&a, &bits, sizeof a);
-    return (e.head & negative_bit) ? -a : a;
-  }
-
-  /// Runs up to `local_sweeps` sweeps of single-vertex moves in vertex
-  /// order on the `n` vertices of `edges`, of which only the first
-  /// `movable` may move; returns the number of moves.
-  std::size_t improve_vertices(std::size_t n, std::size_t movable, const std::vector<Sorted_edge>& edges,
-                               std::vector<Label>& label) const
-  {
-    // Incidence lists of the informative edges (both directions).
-    std::vector<std::uint32_t> first(n + 1, 0);
-    for (const Sorted_edge& e : edges) {
-      ++first[e.tail + 1];
-      ++first[(e.head & ~negative_bit) + 1];
-    }
-    for (std::size_t i = 0; i < n; ++i)
-      first[i + 1] += first[i];
-    std::vector<std::pair<std::uint32_t, float>> incident(first[n]);
-    {
-      std::vector<std::uint32_t> next(first.begin(), first.end() - 1);
-      for (const Sorted_edge& e : edges) {
-        const std::uint32_t v = e.head & ~negative_bit;
-        const float w = signed_weight(e);
-        incident[next[e.tail]++] = {v, w};
-        incident[next[v]++] = {e.tail, w};
-      }
-    }
-    // Flipping i changes the energy by sum_j w_ij L_i L_j: flip when < 0.
-    std::size_t moves = 0;
-    for (unsigned int sweep = 0; sweep < local_sweeps; ++sweep) {
-      std::size_t moved = 0;
-      for (std::size_t i = 0; i < movable; ++i) {
-        double support = 0.0;
-        for (std::uint32_t t = first[i]; t < first[i + 1]; ++t)
-          support += double(incident[t].second) * double(label[incident[t].first]);
-        if (support * double(label[i]) < 0.0) {
+    if (with_unary && label[ground] < 0) {
+      const auto ground_root = uf.find(ground);
+      for (std::size_t i = 0; i < vertex_count; ++i)
+        if (uf.find(std::uint32_t(i)) == ground_root)
           label[i] = Label(-label[i]);
-          ++moved;
-        }
-      }
-      moves += moved;
-      if (moved == 0)
-        break;
     }
-    return moves;
+    label.resize(n);
+
+    // 5. Sweeps of single-vertex moves, the unary terms as preferences.
+    if (local_sweeps > 0 || incidence) {
+      internal::Incidence own;
+      internal::Incidence& inc = incidence ? *incidence : own;
+      inc = internal::Incidence(g, weight, "Mst_solver");
+      if (local_sweeps > 0)
+        report.iterations += internal::improve_by_sweeps(inc, preference, label, local_sweeps);
+    }
+    std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, unary, label, labels);
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
   }
 };
 

@@ -137,21 +137,19 @@ private:
     const auto start = std::chrono::steady_clock::now();
     const std::size_t n = std::size_t(num_vertices(g));
     auto index = get(boost::vertex_index, g);
-    constexpr bool with_unary = !std::is_same<UnaryMap, internal::No_unary>::value;
 
-    // 1. Starting labelling.
+    // 1. Starting labelling; the MST leaves the incidence lists of large
+    //    graphs for the sweeps after the segment graph.
+    const bool reduced = reduce && n > reduction_threshold;
+    internal::Incidence incidence;
     std::vector<Label> y(n, Label(1));
     const auto y_map = boost::make_iterator_property_map(y.begin(), index);
-    if constexpr (with_unary)
-      initial.solve(g, weight, unary, y_map);
-    else
-      initial.solve(g, weight, y_map);
+    const Solver_report start_report = initial.solve_forest(g, weight, unary, y_map, reduced ? &incidence : nullptr);
 
     // 2. QPBO-I, on the segment graph of large problems.
     Solver_report report;
     std::vector<Label> x;
-    if (reduce && n > reduction_threshold) {
-      const internal::Incidence incidence(g, weight, "Qpbo_i_solver");
+    if (reduced) {
       const std::vector<double> preference = internal::unary_preferences(g, unary, "Qpbo_i_solver");
       // Dense frustration (strong noise) breaks the segments up: then the
       // contradiction tolerance theta_S is raised, up to 1, and a single
@@ -173,21 +171,18 @@ private:
     } else {
       x = improve(internal::make_array_problem(g, weight, unary, "Qpbo_i_solver"), y, orders, report);
     }
-    // Keep the starting labelling unless strictly lower (exact energies).
-    auto total_energy = [&](const std::vector<Label>& l) {
-      const auto map = boost::make_iterator_property_map(l.cbegin(), index);
-      if constexpr (with_unary)
-        return energy(g, weight, unary, map);
+    // Keep the starting labelling unless strictly lower (exact energies;
+    // the MST's report holds the energy of y, summed alike).
+    report.energy = start_report.energy;
+    report.frustrated_edges = start_report.frustrated_edges;
+    if (x != y) {
+      const std::pair<double, std::size_t> moved = internal::labelling_energy(g, weight, unary, x);
+      if (moved.first < start_report.energy)
+        std::tie(report.energy, report.frustrated_edges) = moved;
       else
-        return energy(g, weight, map);
-    };
-    if (x != y && !(total_energy(x) < total_energy(y)))
-      x = y;
-
-    if constexpr (with_unary)
-      std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, unary, x, labels);
-    else
-      std::tie(report.energy, report.frustrated_edges) = internal::write_labels(g, weight, x, labels);
+        x = y;
+    }
+    internal::put_labels(g, x, labels);
     report.starting_labels = std::move(y);
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;
