@@ -932,7 +932,7 @@ TEST(Global_sign, PatchesAreTheSameForAnyNumberOfThreads)
     bool same_cell = true;
     for (int c = 0; c < 3; ++c)
       same_cell = same_cell && std::floor((points[i][c] - lo[c]) / cell) == std::floor((points[j][c] - lo[c]) / cell);
-    if (same_cell && NO::internal::same_sheet(mi, mj, slopes[e], NO::internal::sheet_slope)) {
+    if (same_cell && NO::internal::same_sheet(mi * mj, slopes[e], NO::internal::sheet_slope)) {
       ++joined;
       EXPECT_EQ(a[i], a[j]) << i << " " << j;
     }

@@ -58,12 +58,13 @@ inline std::array<double, 3> fibonacci_direction(unsigned int i, unsigned int co
 }
 
 /// Adds to `vote` the view from direction `d` (towards the viewer): for
-/// every sample that no splat hides, weight (n . d).  `radius` holds the
+/// every sample that no splat hides, weight (n . d) (nothing when `weight`
+/// is 0); and n . d to `*even` unless it is null.  `radius` holds the
 /// splats' radii, `cell` the smallest pixel side.
 template <typename Point, typename Vector>
 void add_view(const std::vector<Point>& points, const std::vector<Vector>& normals, const std::vector<double>& radius,
               const std::array<double, 3>& d, double weight, double cell, unsigned int maximum_resolution,
-              std::vector<double>& vote)
+              std::vector<double>& vote, std::vector<double>* even = nullptr)
 {
   // an orthonormal frame (u, v, d)
   const std::array<double, 3> a = std::abs(d[0]) < 0.9 ? std::array<double, 3>{{1, 0, 0}} : std::array<double, 3>{{0, 1, 0}};
@@ -113,8 +114,12 @@ void add_view(const std::vector<Point>& points, const std::vector<Vector>& norma
     const double c = (m.x() * d[0] + m.y() * d[1] + m.z() * d[2]) / length;
     // the splats of a plane through the sample reach r tan(angle) nearer
     const double slope = std::min(4.0, std::sqrt(std::max(0.0, 1.0 - c * c)) / std::max(std::abs(c), 1e-3));
-    if (t[j] >= double(front) - (0.5 + slope) * radius[j])
-      vote[j] += weight * c;
+    if (t[j] >= double(front) - (0.5 + slope) * radius[j]) {
+      if (weight > 0.0)
+        vote[j] += weight * c;
+      if (even)
+        (*even)[j] += c;
+    }
   }
 }
 
@@ -166,6 +171,62 @@ inline double median_radius(std::vector<double> radius)
   return std::max(radius[radius.size() / 2], std::numeric_limits<double>::min());
 }
 
+/// `exterior_visibility()`; with `even` not null, also the votes of the same
+/// views, each of weight 1 (those of `options` without an up direction),
+/// in `*even`: the views are drawn once.
+template <typename ConcurrencyTag, typename Point, typename Vector>
+std::vector<double> visibility_votes(const std::vector<Point>& points, const std::vector<Vector>& normals,
+                                     const std::vector<double>& areas, const Exterior_visibility_options& options,
+                                     std::vector<double>* even)
+{
+  const std::size_t n = points.size();
+  const std::vector<double> radius = splat_radii(points, normals, areas, options, "exterior_visibility");
+  std::vector<double> vote(n, 0.0);
+  if (even)
+    even->assign(n, 0.0);
+  if (n == 0)
+    return vote;
+  const double cell = median_radius(radius);
+  // Fixed blocks of directions, summed in order: the same votes for any
+  // thread count.
+  const unsigned int count = options.number_of_directions, blocks = std::min(8u, count);
+  std::vector<std::vector<double>> partial(blocks, std::vector<double>(n, 0.0));
+  std::vector<std::vector<double>> even_partial(even ? blocks : 0u, std::vector<double>(n, 0.0));
+  auto view_weight = [&](const std::array<double, 3>& d) {
+    return d[0] * options.up[0] + d[1] * options.up[1] + d[2] * options.up[2] < 0.0 ? options.below_horizon_weight
+                                                                                    : 1.0;
+  };
+  double total_weight = 0.0;
+  for (unsigned int i = 0; i < count; ++i)
+    total_weight += view_weight(fibonacci_direction(i, count));
+  parallel_chunks<ConcurrencyTag>(
+    blocks,
+    [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k)
+        for (unsigned int i = unsigned(k); i < count; i += blocks) {
+          const std::array<double, 3> d = fibonacci_direction(i, count);
+          const double weight = view_weight(d);
+          if (weight > 0.0 || even)
+            add_view(points, normals, radius, d, weight, cell, options.maximum_resolution, partial[k],
+                     even ? &even_partial[k] : nullptr);
+        }
+    },
+    1);
+  for (unsigned int k = 0; k < blocks; ++k)
+    for (std::size_t j = 0; j < n; ++j)
+      vote[j] += partial[k][j];
+  for (double& x : vote)
+    x /= total_weight;
+  if (even) {
+    for (unsigned int k = 0; k < blocks; ++k)
+      for (std::size_t j = 0; j < n; ++j)
+        (*even)[j] += even_partial[k][j];
+    for (double& x : *even)
+      x /= double(count);
+  }
+  return vote;
+}
+
 } // namespace internal
 /// \endcond
 
@@ -197,41 +258,7 @@ std::vector<double> exterior_visibility(const std::vector<Point>& points, const 
                                         const std::vector<double>& areas,
                                         const Exterior_visibility_options& options = {})
 {
-  const std::size_t n = points.size();
-  const std::vector<double> radius = internal::splat_radii(points, normals, areas, options, "exterior_visibility");
-  std::vector<double> vote(n, 0.0);
-  if (n == 0)
-    return vote;
-  const double cell = internal::median_radius(radius);
-  // Fixed blocks of directions, summed in order: the same votes for any
-  // thread count.
-  const unsigned int count = options.number_of_directions, blocks = std::min(8u, count);
-  std::vector<std::vector<double>> partial(blocks, std::vector<double>(n, 0.0));
-  auto view_weight = [&](const std::array<double, 3>& d) {
-    return d[0] * options.up[0] + d[1] * options.up[1] + d[2] * options.up[2] < 0.0 ? options.below_horizon_weight
-                                                                                    : 1.0;
-  };
-  double total_weight = 0.0;
-  for (unsigned int i = 0; i < count; ++i)
-    total_weight += view_weight(internal::fibonacci_direction(i, count));
-  internal::parallel_chunks<ConcurrencyTag>(
-    blocks,
-    [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k)
-        for (unsigned int i = unsigned(k); i < count; i += blocks) {
-          const std::array<double, 3> d = internal::fibonacci_direction(i, count);
-          const double weight = view_weight(d);
-          if (weight > 0.0)
-            internal::add_view(points, normals, radius, d, weight, cell, options.maximum_resolution, partial[k]);
-        }
-    },
-    1);
-  for (unsigned int k = 0; k < blocks; ++k)
-    for (std::size_t j = 0; j < n; ++j)
-      vote[j] += partial[k][j];
-  for (double& x : vote)
-    x /= total_weight;
-  return vote;
+  return internal::visibility_votes<ConcurrencyTag>(points, normals, areas, options, nullptr);
 }
 
 /// \ingroup PkgNormalOrientationGlobal

@@ -142,12 +142,12 @@ inline double patch_slope(const std::vector<float>& slopes)
 }
 
 /// Whether an edge joins two points of one smooth sheet that the solver
-/// oriented consistently: the oriented normals `mi`, `mj` of its ends agree
-/// within 60 degrees and its slope (`edge_slopes()`) is at most `max_slope`.
-template <typename Vector>
-bool same_sheet(const Vector& mi, const Vector& mj, float slope, double max_slope)
+/// oriented consistently: the oriented normals of its ends agree within 60
+/// degrees (`product`, their scalar product, is at least 1/2) and its slope
+/// (`edge_slopes()`) is at most `max_slope`.
+inline bool same_sheet(double product, float slope, double max_slope)
 {
-  return CGAL::to_double(mi * mj) >= 0.5 && double(slope) <= max_slope;
+  return double(slope) <= max_slope && product >= 0.5;
 }
 
 /// Unites the ends of every edge `e` of `graph` with `joins[e]` in `uf`
@@ -213,13 +213,17 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph,
         for (int c = 0; c < 3; ++c)
           cells[i] = (cells[i] << 21) | (std::uint64_t((CGAL::to_double(points[i][c]) - lo[c]) / cell) & 0x1FFFFF);
     });
-  auto oriented = [&](std::size_t i) { return labels[i] < 0 ? -normals[i] : normals[i]; };
+  // (the product of the oriented normals, exactly: negation is exact)
+  auto oriented_product = [&](std::size_t i, std::size_t j) {
+    const double d = CGAL::to_double(normals[i] * normals[j]);
+    return labels[i] == labels[j] ? d : -d;
+  };
   auto same_move = [&](std::size_t i, std::size_t j) { return moved.empty() || moved[i] == moved[j]; };
   // Per edge (in the order of edges(graph), which is that of the sources'
-  // out-edges): 1 when it joins its ends into one patch.
+  // out-edges): 1 when it joins its ends into one patch (`same_sheet()`).
   std::vector<unsigned char> joins(num_edges(graph), 0);
   for_each_edge_in_parallel<ConcurrencyTag>(graph, [&](std::size_t i, std::size_t j, std::size_t e) {
-    joins[e] = cells[i] == cells[j] && same_move(i, j) && same_sheet(oriented(i), oriented(j), slopes[e], max_slope);
+    joins[e] = cells[i] == cells[j] && same_move(i, j) && same_sheet(oriented_product(i, j), slopes[e], max_slope);
   });
   Signed_union_find uf(n);
   unite_joined_edges<ConcurrencyTag>(graph, joins, uf);
@@ -234,7 +238,7 @@ std::vector<std::uint32_t> build_patches(const Neighbor_graph& graph,
       sampled[root[i]] = 1;
   }
   for_each_edge_in_parallel<ConcurrencyTag>(graph, [&](std::size_t i, std::size_t j, std::size_t e) {
-    joins[e] = root[i] != root[j] && oriented(i) * oriented(j) > 0.0;
+    joins[e] = root[i] != root[j] && oriented_product(i, j) > 0.0;
   });
   std::vector<std::pair<Index, Index>> between;
   typename boost::graph_traits<Neighbor_graph>::edge_iterator it, end;
@@ -467,9 +471,8 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING) {
     for (std::size_t t = 0; t < ns; ++t)
       sample_segment[t] = segment[samples.index[t]];
-    segment_flip = segment_tier_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
-                                                      samples.component, sample_sheet, sample_segment,
-                                                      number_of_segments, seen, component_fixed, settings);
+    segment_flip = segment_tier_flips(samples.areas, samples.component, sample_sheet, sample_segment,
+                                      number_of_segments, seen, component_fixed, settings);
     for (char f : segment_flip)
       seen.patches_flipped += f ? 1 : 0;
   }

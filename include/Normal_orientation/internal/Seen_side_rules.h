@@ -56,6 +56,9 @@ struct Seen_side_flips
   std::vector<char> component; ///< per component id: the whole component negates
   std::vector<char> patch;     ///< per patch id: the patch negates (after its component)
   std::vector<double> vote;    ///< per sample: `exterior_visibility()` of the input orientation
+  /// per sample: the votes of the same views, each of weight 1 (empty
+  /// without visibility or without an up direction, where `vote` is that)
+  std::vector<double> even_vote;
   std::size_t components_flipped = 0;
   std::size_t patches_flipped = 0;
 };
@@ -86,7 +89,9 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
   std::vector<char> free_component(number_of_components, 1), free_patch(number_of_patches, 0);
   for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
     free_component[c] = !fixed[c];
-  out.vote = exterior_visibility<ConcurrencyTag>(points, oriented, areas, settings.visibility());
+  const Exterior_visibility_options options = settings.visibility();
+  const bool weighted = options.up != std::array<double, 3>{{0.0, 0.0, 0.0}};
+  out.vote = visibility_votes<ConcurrencyTag>(points, oriented, areas, options, weighted ? &out.even_vote : nullptr);
   for (std::size_t j = 0; j < two_layers.size(); ++j)
     if (two_layers[j])
       out.vote[j] = 0.0;
@@ -122,42 +127,36 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
 /// sheets of `seen`: the segments (`sample_segment`, per sample, below
 /// `number_of_segments`) that still face away from where they were seen,
 /// both by the votes of `seen` (views below the horizon weigh less) and by
-/// views that all weigh 1 (`normals`: the orientation that `seen` voted
-/// on).  The solvers' errors are whole segments; but the lower part of an
-/// object scanned from one side faces down, and the views from above see it
-/// from behind, through the open back: only they would turn it.  (The
-/// views of weight 1 are drawn only where the first votes turn a segment
-/// and there is an up direction.)  Nothing unless `settings` asks for
-/// visibility.
-template <typename ConcurrencyTag, typename Point, typename Vector>
-std::vector<char> segment_tier_flips(const std::vector<Point>& points, const std::vector<Vector>& normals,
-                                     const std::vector<double>& areas,
-                                     const std::vector<std::uint32_t>& sample_component,
-                                     const std::vector<std::uint32_t>& sample_sheet,
-                                     const std::vector<std::uint32_t>& sample_segment, std::size_t number_of_segments,
-                                     const Seen_side_flips& seen, const std::vector<char>& component_fixed,
-                                     const Global_settings& settings)
+/// its votes of views that all weigh 1 (`Seen_side_flips::even_vote`).
+/// The solvers' errors are whole segments; but the lower part of an object
+/// scanned from one side faces down, and the views from above see it from
+/// behind, through the open back: only they would turn it.  Nothing unless
+/// `settings` asks for visibility.
+inline std::vector<char> segment_tier_flips(const std::vector<double>& areas,
+                                            const std::vector<std::uint32_t>& sample_component,
+                                            const std::vector<std::uint32_t>& sample_sheet,
+                                            const std::vector<std::uint32_t>& sample_segment,
+                                            std::size_t number_of_segments, const Seen_side_flips& seen,
+                                            const std::vector<char>& component_fixed, const Global_settings& settings)
 {
-  if (points.empty() || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
+  const std::size_t ns = sample_component.size();
+  if (ns == 0 || settings.orientation != Global_orientation::VISIBILITY_AND_WINDING)
     return std::vector<char>(number_of_segments, 0);
   // (the votes as they stand after the components and sheets of `seen`)
   auto after_seen = [&](std::vector<double> v) {
-    for (std::size_t j = 0; j < points.size(); ++j)
+    for (std::size_t j = 0; j < ns; ++j)
       if (seen.component[sample_component[j]] != seen.patch[sample_sheet[j]])
         v[j] = -v[j];
     return v;
   };
   std::vector<char> free_segment(number_of_segments, 0);
-  for (std::size_t j = 0; j < points.size(); ++j)
+  for (std::size_t j = 0; j < ns; ++j)
     free_segment[sample_segment[j]] = !component_fixed[sample_component[j]];
   std::vector<char> flip = visibility_flips(after_seen(seen.vote), areas, sample_segment, free_segment);
-  const Exterior_visibility_options weighted = settings.visibility();
-  if (std::find(flip.begin(), flip.end(), 1) == flip.end() || weighted.up == std::array<double, 3>{{0.0, 0.0, 0.0}})
-    return flip; // (nothing to confirm, or every view already weighs 1)
-  Exterior_visibility_options even = weighted;
-  even.up = {{0.0, 0.0, 0.0}}; // (every view weighs 1)
-  const std::vector<char> even_flip = visibility_flips(
-    after_seen(exterior_visibility<ConcurrencyTag>(points, normals, areas, even)), areas, sample_segment, free_segment);
+  if (seen.even_vote.empty())
+    return flip; // (every view already weighs 1)
+  const std::vector<char> even_flip =
+    visibility_flips(after_seen(seen.even_vote), areas, sample_segment, free_segment);
   for (std::size_t P = 0; P < flip.size(); ++P)
     flip[P] = char(flip[P] && even_flip[P]);
   return flip;

@@ -275,9 +275,8 @@ Stream_seen_sides stream_seen_sides(const Global_samples<Kernel>& samples, const
     out.number_of_sheets, component_fixed, settings, {}, samples.two_layers);
   std::vector<char> segment_flip(number_of_segments, 0);
   if (units && settings.orientation == Normal_orientation::Global_orientation::VISIBILITY_AND_WINDING) {
-    segment_flip = Normal_orientation::internal::segment_tier_flips<ConcurrencyTag>(
-      samples.points, samples.normals, areas, samples.component, out.sheet, segment_patch, number_of_segments,
-      out.seen, component_fixed, settings);
+    segment_flip = Normal_orientation::internal::segment_tier_flips(
+      areas, samples.component, out.sheet, segment_patch, number_of_segments, out.seen, component_fixed, settings);
     for (char f : segment_flip)
       out.seen.patches_flipped += f ? 1 : 0;
   }

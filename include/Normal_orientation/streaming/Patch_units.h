@@ -78,7 +78,7 @@ public:
       if (e < kept)
         slope[e] = s;
       if (!o.has_normal || o.component != component ||
-          !Normal_orientation::internal::same_sheet(m, o.normal, float(s), m_split_slope))
+          !Normal_orientation::internal::same_sheet(CGAL::to_double(m * o.normal), float(s), m_split_slope))
         continue;
       if (sheet == no_sheet)
         sheet = find(o.sheet);
