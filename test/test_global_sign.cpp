@@ -397,6 +397,33 @@ TEST(Exterior_visibility, VotesOfAClosedSurfaceAndOfASheet)
   EXPECT_TRUE(one == NO::exterior_visibility<CGAL::Parallel_tag>(p, n, areas));
 }
 
+TEST(Exterior_visibility, OneDrawingGivesBothWeightings)
+{
+  // the even votes drawn with the weighted ones are those of the views
+  // without an up direction, bit for bit, also when views below weigh 0
+  std::mt19937_64 rng(17);
+  std::vector<Sample> cup = NO::test::sphere(3000, rng);
+  cup.erase(std::remove_if(cup.begin(), cup.end(), [](const Sample& t) { return t.p.z() > 0.5; }), cup.end());
+  std::vector<Point> p;
+  std::vector<Vector> n;
+  for (const Sample& t : cup) {
+    p.push_back(t.p);
+    n.push_back(t.n);
+  }
+  const std::vector<double> areas = NO::estimate_point_areas<CGAL::Sequential_tag>(p, n);
+  for (double below : {0.1, 0.0}) {
+    NO::Exterior_visibility_options weighted, even;
+    weighted.below_horizon_weight = below;
+    even.up = {{0.0, 0.0, 0.0}};
+    std::vector<double> even_votes;
+    const std::vector<double> votes =
+      NO::internal::visibility_votes<CGAL::Parallel_tag>(p, n, areas, weighted, &even_votes);
+    EXPECT_TRUE(votes == NO::exterior_visibility<CGAL::Sequential_tag>(p, n, areas, weighted)) << below;
+    EXPECT_TRUE(even_votes == NO::exterior_visibility<CGAL::Sequential_tag>(p, n, areas, even)) << below;
+    EXPECT_FALSE(votes == even_votes) << below; // (the open cup faces up: the weights matter)
+  }
+}
+
 TEST(Exterior_visibility, BadInputThrows)
 {
   std::vector<Point> p = {Point(0, 0, 0), Point(1, 0, 0)};
