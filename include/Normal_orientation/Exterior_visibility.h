@@ -212,18 +212,17 @@ std::vector<double> visibility_votes(const std::vector<Point>& points, const std
         }
     },
     1);
-  for (unsigned int k = 0; k < blocks; ++k)
-    for (std::size_t j = 0; j < n; ++j)
-      vote[j] += partial[k][j];
-  for (double& x : vote)
-    x /= total_weight;
-  if (even) {
-    for (unsigned int k = 0; k < blocks; ++k)
+  // (the blocks' sums in block order, over the total weight)
+  auto fold = [&](const std::vector<std::vector<double>>& blocks_sums, double total, std::vector<double>& out) {
+    for (const std::vector<double>& block_sums : blocks_sums)
       for (std::size_t j = 0; j < n; ++j)
-        (*even)[j] += even_partial[k][j];
-    for (double& x : *even)
-      x /= double(count);
-  }
+        out[j] += block_sums[j];
+    for (double& x : out)
+      x /= total;
+  };
+  fold(partial, total_weight, vote);
+  if (even)
+    fold(even_partial, double(count), *even);
   return vote;
 }
 

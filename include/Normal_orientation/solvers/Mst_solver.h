@@ -21,7 +21,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <limits>
 #include <stdexcept>
 #include <tuple>
 #include <type_traits>
@@ -65,8 +64,8 @@ namespace Normal_orientation {
 /// are ranked with the others (after the edges of `g` of the same rank) and
 /// the same algorithm runs on the n + 1 vertices; then, if the ground came
 /// out -1, every vertex of its tree flips (which does not change the energy
-/// of the tree's edges), and the sweeps add c- - c+ to the weight of the
-/// edges for label +1 at every vertex.  So a vertex whose unary cost difference
+/// of the tree's edges); the sweeps weigh c- - c+ for label +1 at every
+/// vertex, with its edges.  So a vertex whose unary cost difference
 /// exceeds the sum of the |w| of its edges ends with its cheaper label (up
 /// to the single-precision rounding of the ranks and sweeps);
 /// conflicting constraints are decided by the forest, strongest first.
