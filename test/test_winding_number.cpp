@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // Tests of Winding_number_field and estimate_point_areas: the treecode against
-// the direct sum, a sampled sphere, a flipped patch, thread counts, areas.
+// the direct sum, a sampled sphere, a flipped patch, thread counts, areas,
+// the caps of the smoothing widths and the layer gaps that give them.
 
 #include <Normal_orientation/Winding_number_field.h>
+#include <Normal_orientation/internal/Layer_gap.h>
 
 #include "Synthetic_shapes.h"
 
@@ -437,4 +439,135 @@ TEST(Winding_number_field, SmallAndBadInputs)
              std::vector<double>(100, 0.01), 1);
   EXPECT_NEAR(same.value(Point(0, 1, 1)), same.direct_value(Point(0, 1, 1)), 1e-15);
   EXPECT_TRUE(std::isfinite(same.value(Point(1, 1, 1))));
+}
+
+TEST(Winding_number_field, WidthCapsSharpenTheFieldAtAContact)
+{
+  // Two unit spheres, all normals outward, 0.4 spacings apart.  The energy
+  // sum a (w - 1/2)^2 over the contact samples of the first sphere tells the
+  // right signs from those with the second sphere's contact region P
+  // negated (w moves by -2 w_P) only weakly when the field is smoothed over
+  // one spacing: w_P reads well above 0 outside P's sphere.  With the widths
+  // near the contact capped (at 0.35 spacings, as the global stage floors
+  // its caps), the right signs cost clearly less than the negated ones.
+  std::mt19937_64 rng(5);
+  const double gap = 0.01; // (the spacing is about 0.025)
+  std::vector<NO::test::Sample> a = NO::test::sphere(20000, rng), b = NO::test::sphere(20000, rng, Point(2.0 + gap, 0, 0));
+  a.insert(a.end(), b.begin(), b.end());
+  const Cloud c = make_cloud(a);
+  const std::size_t n = c.points.size();
+  std::vector<double> caps(n, HUGE_VAL);
+  std::vector<std::size_t> contact;   // (samples of the first sphere within 0.02 of the second)
+  Cloud region;                        // P: those of the second sphere within 0.02 of the first
+  std::vector<double> region_caps;
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool first = i < 20000;
+    const double to_other = std::sqrt(CGAL::squared_distance(c.points[i], first ? Point(2.0 + gap, 0, 0) : Point(0, 0, 0))) - 1.0;
+    if (to_other < 0.02) {
+      caps[i] = 0.35 * std::sqrt(c.areas[i]);
+      if (first) {
+        contact.push_back(i);
+      } else {
+        region.points.push_back(c.points[i]);
+        region.normals.push_back(c.normals[i]);
+        region.areas.push_back(c.areas[i]);
+        region_caps.push_back(caps[i]);
+      }
+    }
+  }
+  ASSERT_GT(contact.size(), 20u);
+  ASSERT_GT(region.points.size(), 20u);
+  Field smooth, sharp, smooth_p, sharp_p;
+  smooth.build(c.points, c.normals, c.areas);
+  sharp.build(c.points, c.normals, c.areas, caps);
+  smooth_p.build(region.points, region.normals, region.areas);
+  sharp_p.build(region.points, region.normals, region.areas, region_caps);
+  auto energies = [&](const Field& all, const Field& p, double& right, double& negated) {
+    right = negated = 0.0;
+    for (std::size_t i : contact) {
+      const double w = all.value(c.points[i]), wp = p.value(c.points[i]);
+      right += c.areas[i] * (w - 0.5) * (w - 0.5);
+      negated += c.areas[i] * (w - 2.0 * wp - 0.5) * (w - 2.0 * wp - 0.5);
+    }
+  };
+  double smooth_right, smooth_negated, sharp_right, sharp_negated;
+  energies(smooth, smooth_p, smooth_right, smooth_negated);
+  energies(sharp, sharp_p, sharp_right, sharp_negated);
+  std::cout << "contact samples " << contact.size() << ", region " << region.points.size()
+            << ": energy right / P negated " << smooth_right << " / " << smooth_negated << " smoothed, "
+            << sharp_right << " / " << sharp_negated << " with caps\n";
+  EXPECT_GT(sharp_negated / sharp_right, 1.5 * (smooth_negated / smooth_right));
+  EXPECT_GT(sharp_negated, 3.0 * sharp_right);
+  EXPECT_LT(sharp_right, smooth_right);
+  // the caps are used by the treecode as by the direct sum, and by the widths
+  std::vector<Point> q;
+  for (std::size_t t = 0; t < contact.size(); ++t)
+    q.push_back(c.points[contact[t]] + Vector(0.5 * gap, 0.0, 0.0));
+  const std::vector<Point> far = make_queries(c, 500, 3);
+  q.insert(q.end(), far.begin(), far.end());
+  std::vector<double> exact, approx;
+  sharp.evaluate_direct(q, exact);
+  sharp.evaluate(q, approx);
+  EXPECT_LT(max_abs_difference(approx, exact), 0.015);
+  EXPECT_DOUBLE_EQ(sharp.smoothing_width(contact[0]), 0.35 * std::sqrt(c.areas[contact[0]]));
+  EXPECT_DOUBLE_EQ(sharp.width_cap(contact[0]), 0.35 * std::sqrt(c.areas[contact[0]]));
+  std::size_t leftmost = 0; // (far from the contact)
+  for (std::size_t i = 0; i < 20000; ++i)
+    if (c.points[i].x() < c.points[leftmost].x())
+      leftmost = i;
+  EXPECT_EQ(sharp.width_cap(leftmost), HUGE_VAL);
+  EXPECT_DOUBLE_EQ(sharp.smoothing_width(leftmost), smooth.smoothing_width(leftmost));
+  EXPECT_EQ(smooth.width_cap(contact[0]), HUGE_VAL);
+  // no caps (all +inf) is the field without caps, bit for bit
+  Field none;
+  none.build(c.points, c.normals, c.areas, std::vector<double>(n, HUGE_VAL));
+  std::vector<double> plain, capped;
+  smooth.evaluate(q, plain);
+  none.evaluate(q, capped);
+  EXPECT_EQ(plain, capped);
+  // bad caps
+  EXPECT_THROW(none.build(c.points, c.normals, c.areas, std::vector<double>(n - 1, 1.0)), std::invalid_argument);
+  caps[7] = -1.0;
+  EXPECT_THROW(none.build(c.points, c.normals, c.areas, caps), std::invalid_argument);
+  caps[7] = std::nan("");
+  EXPECT_THROW(none.build(c.points, c.normals, c.areas, caps), std::invalid_argument);
+}
+
+TEST(Layer_gap, AnotherLayerIsSteepAndParallel)
+{
+  namespace I = NO::internal;
+  const double p[3] = {0, 0, 0}, up[3] = {0, 0, 1};
+  const double above[3] = {0.3, 0, 0.2}, beside[3] = {0.3, 0, 0.01};
+  const double down[3] = {0, 0, -2}, tilted[3] = {0.5, 0, 1}, across[3] = {1, 0, 0}, zero[3] = {0, 0, 0};
+  // a parallel layer above (slope 0.55, opposite normal of any length): its distance
+  EXPECT_DOUBLE_EQ(I::layer_gap_to(p, up, above, down), std::sqrt(0.13));
+  // the same surface (slope 0.03), a crease (normals at right angles), a
+  // bend of 27 degrees (|cos| 0.89), a zero normal, the same position: none
+  EXPECT_EQ(I::layer_gap_to(p, up, beside, up), HUGE_VAL);
+  EXPECT_EQ(I::layer_gap_to(p, up, above, across), HUGE_VAL);
+  EXPECT_EQ(I::layer_gap_to(p, up, above, tilted), HUGE_VAL);
+  EXPECT_EQ(I::layer_gap_to(p, up, above, zero), HUGE_VAL);
+  EXPECT_EQ(I::layer_gap_to(p, zero, above, up), HUGE_VAL);
+  EXPECT_EQ(I::layer_gap_to(p, up, p, up), HUGE_VAL);
+  // 8-bit codes: 0 for none, within 1/510 of the radius, at least 1, at most 255
+  EXPECT_EQ(I::layer_gap_code(HUGE_VAL, 1.0), 0);
+  EXPECT_EQ(I::layer_gap_value(0, 1.0), HUGE_VAL);
+  for (double g : {1e-9, 0.003, 0.1, 0.4567, 0.99, 1.0, 3.0}) {
+    const std::uint8_t code = I::layer_gap_code(g, 2.0);
+    EXPECT_GE(code, 1);
+    EXPECT_LE(std::abs(I::layer_gap_value(code, 2.0) - std::min(g, 2.0)), 2.0 / 255.0);
+  }
+  // the caps: the factor times the gaps, +inf without one; none when too
+  // many points have a gap (noise) or no sample has one
+  // (3 samples of a cloud of 100 points: a sample of area a stands for
+  // points of spacing sqrt(3 a / 100); the floor binds on the last one)
+  const std::vector<std::uint8_t> codes = {0, 51, 1};
+  const std::vector<double> areas = {1.0, 0.01, 1.0};
+  const std::vector<double> caps = I::contact_width_caps(codes, 30, 100, 2.0, areas);
+  ASSERT_EQ(caps.size(), 3u);
+  EXPECT_EQ(caps[0], HUGE_VAL);
+  EXPECT_DOUBLE_EQ(caps[1], I::contact_width_factor * 0.4);
+  EXPECT_DOUBLE_EQ(caps[2], I::contact_width_floor * std::sqrt(0.03));
+  EXPECT_TRUE(I::contact_width_caps(codes, 36, 100, 2.0, areas).empty());
+  EXPECT_TRUE(I::contact_width_caps(std::vector<std::uint8_t>(3, 0), 30, 100, 2.0, areas).empty());
 }

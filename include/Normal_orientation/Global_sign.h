@@ -209,16 +209,17 @@ double negation_change(const Field& field, const std::vector<Point>& points, con
 {
   std::vector<typename Kernel::Point_3> p;
   std::vector<typename Kernel::Vector_3> m;
-  std::vector<double> a;
+  std::vector<double> a, caps;
   for (std::uint32_t j : members) {
     p.push_back(points[j]);
     m.push_back(field.moment(j)); // a s n: its length is the area, its direction the signed normal
     a.push_back(areas[j]);
+    caps.push_back(field.width_cap(j));
   }
   Winding_number_field<Kernel> patch_field;
   patch_field.set_opening_ratio(field.opening_ratio());
   patch_field.set_smoothing_factor(field.smoothing_factor());
-  patch_field.template build<ConcurrencyTag>(p, m, a);
+  patch_field.template build<ConcurrencyTag>(p, m, a, caps);
   std::vector<double> c(points.size()); // (the samples are in a spatial order already: no sort)
   parallel_chunks<ConcurrencyTag>(points.size(), [&](std::size_t b, std::size_t e) {
     for (std::size_t j = b; j < e; ++j)
@@ -265,16 +266,17 @@ public:
   typedef typename Kernel::Vector_3 Vector_3;
 
   /// Builds the field over the samples (oriented normals and areas as for
-  /// `decide_patch_signs()`) and evaluates w at them.
+  /// `decide_patch_signs()`, the caps of the smoothing widths as for
+  /// `Winding_number_field::build()`, empty: none) and evaluates w at them.
   template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
   void build(const std::vector<Point_3>& points, const std::vector<Vector_3>& normals,
-             const std::vector<double>& areas)
+             const std::vector<double>& areas, const std::vector<double>& width_caps = std::vector<double>())
   {
     if (normals.size() != points.size() || areas.size() != points.size())
       throw std::invalid_argument("Winding_patch_signs: points, normals and areas differ in size");
     m_points = points;
     m_areas = areas;
-    m_field.template build<ConcurrencyTag>(points, normals, areas);
+    m_field.template build<ConcurrencyTag>(points, normals, areas, width_caps);
     m_energy = internal::winding_energy<ConcurrencyTag>(m_field, m_points, m_areas, m_w);
   }
 

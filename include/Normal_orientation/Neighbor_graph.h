@@ -10,6 +10,7 @@
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/internal/Clean_positions.h>
 #include <Normal_orientation/internal/Layer_edges.h>
+#include <Normal_orientation/internal/Layer_gap.h>
 #include <Normal_orientation/internal/Parallel.h>
 
 #include <CGAL/Kd_tree.h>
@@ -240,6 +241,36 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
   }
 }
 
+/// The layer gap of every point (`layer_gap_code()` of the least
+/// `layer_gap_to()` over its own k nearest neighbours closer than `radius`;
+/// `nb` and `d2` as `k_nearest_neighbors()` gives them), as the sweep's.
+template <typename ConcurrencyTag, typename Point, typename Vector>
+std::vector<std::uint8_t> layer_gap_codes(const std::vector<Point>& points, const std::vector<Vector>& normals,
+                                          const std::vector<std::uint32_t>& nb, const std::vector<float>& d2,
+                                          unsigned int k, double radius)
+{
+  const std::size_t n = points.size();
+  const double r2 = radius * radius;
+  std::vector<std::uint8_t> codes(n, 0);
+  parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
+    for (std::size_t i = b; i < e; ++i) {
+      double p[3], u[3], x[3], m[3], gap = HUGE_VAL;
+      to_array(points[i], p);
+      to_array(normals[i], u);
+      for (unsigned t = 0; t < k; ++t) {
+        const std::uint32_t j = nb[i * k + t];
+        if (!(double(d2[i * k + t]) < r2) || j == i)
+          continue;
+        to_array(points[j], x);
+        to_array(normals[j], m);
+        gap = std::min(gap, layer_gap_to(p, u, x, m));
+      }
+      codes[i] = layer_gap_code(gap, radius);
+    }
+  });
+  return codes;
+}
+
 } // namespace internal
 /// \endcond
 
@@ -280,6 +311,9 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
 ///        to the other layer's mean along the fitted normal line, zero where
 ///        the point's neighbourhood is one layer (or with
 ///        `negate_across_layers` false)
+/// \param layer_gaps if not null, receives per point the distance to the
+///        nearest of its neighbours on another layer, coded in 8 bits
+///        (`internal::layer_gap_code()`; 0: none)
 /// \pre points and normals are finite (checked by `orient_normals()`)
 /// \return what was measured and decided: the k and r used, the number of edges, the times
 template <typename ConcurrencyTag, typename Kernel, typename FlipCriterion>
@@ -289,7 +323,8 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
                                            Neighbor_graph& graph,
                                            const Progress_reporter& progress = Progress_reporter(),
                                            bool negate_across_layers = true,
-                                           std::vector<std::array<float, 3>>* layer_offsets = nullptr)
+                                           std::vector<std::array<float, 3>>* layer_offsets = nullptr,
+                                           std::vector<std::uint8_t>* layer_gaps = nullptr)
 {
   if (points.size() != normals.size())
     throw std::invalid_argument("build_neighbor_graph: points and normals differ in size");
@@ -375,6 +410,8 @@ Neighbor_graph_report build_neighbor_graph(const std::vector<typename Kernel::Po
       layer, layer_state);
   for (const internal::Layer_offset& t : layer)
     report.number_of_two_layer_points += internal::is_two_layers(t) ? 1 : 0;
+  if (layer_gaps != nullptr)
+    *layer_gaps = internal::layer_gap_codes<ConcurrencyTag>(points, normals, nb, d2, k, radius);
 
   std::vector<std::uint32_t> count(n + 1, 0);
   std::vector<unsigned char> kept(n * k);

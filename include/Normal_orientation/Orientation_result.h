@@ -39,6 +39,9 @@ struct Global_sign_summary
   std::size_t layer_cues = 0;          ///< of `layer_pairs`, those with a sure cue from the far field (streamed: of the samples)
   std::size_t layer_cues_against = 0;  ///< of `layer_cues`, those whose sign the cue negated
   bool layer_cue_round = false;        ///< the solver and the stage ran again, with the cues as unary terms
+  /// the samples whose smoothing width was capped at their layer gap (the
+  /// manual's *Sharp field at contacts*; `Winding_number_field::build()`)
+  std::size_t sharp_samples = 0;
   /// the fraction of the sampled area where w is within the tolerance of
   /// 1/2, after the stage: near 1 on closed surfaces, low on open scans
   double closedness = std::numeric_limits<double>::quiet_NaN();

@@ -210,7 +210,8 @@ std::vector<double> estimate_point_areas(const std::vector<Point>& points, const
 ///
 /// with p_i the points, n_i their unit normals (times a sign that `negate()`
 /// flips), a_i their areas (see `estimate_point_areas()`) and eps_i =
-/// `smoothing_factor()` * sqrt(a_i) the smoothing width.  For a closed surface
+/// `smoothing_factor()` * sqrt(a_i) the smoothing width (sqrt(a_i) or a
+/// smaller cap per point given to `build()`, times the factor).  For a closed surface
 /// sampled densely with outward normals, w is about 1 inside, 0 outside and
 /// 1/2 on the surface; with eps_i > 0 it is finite and smooth everywhere,
 /// on the samples too.  The field is linear in the normals: the field of a
@@ -283,8 +284,33 @@ public:
   void build(const std::vector<Point_3>& points, const std::vector<Vector_3>& normals,
              const std::vector<double>& areas, unsigned int leaf_size = default_winding_leaf_size)
   {
+    build<ConcurrencyTag>(points, normals, areas, std::vector<double>(), leaf_size);
+  }
+
+  /// Builds the field as `build()` above, with the smoothing width of every
+  /// point i capped: eps_i = f min(sqrt(a_i), `width_caps`[i]); a node
+  /// summed as a whole takes the area-weighted mean of its points' squared
+  /// widths.  Narrow widths keep the field of one surface sharp at another
+  /// surface closer than the spacing (the manual's *Sharp field at contacts*).
+  /// \param points the positions, finite
+  /// \param normals the normals, same size (any length)
+  /// \param areas the areas a_i >= 0, same size
+  /// \param width_caps per point, a cap >= 0 (+inf: none); empty: no caps
+  /// \param leaf_size the largest number of points of a leaf, >= 1
+  /// \throw std::invalid_argument when `width_caps` is neither empty nor of
+  ///        the points' size, or holds a negative or NaN cap
+  template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
+  void build(const std::vector<Point_3>& points, const std::vector<Vector_3>& normals,
+             const std::vector<double>& areas, const std::vector<double>& width_caps,
+             unsigned int leaf_size = default_winding_leaf_size)
+  {
     if (points.size() != normals.size() || points.size() != areas.size())
       throw std::invalid_argument("Winding_number_field: points, normals and areas differ in size");
+    if (!width_caps.empty() && width_caps.size() != points.size())
+      throw std::invalid_argument("Winding_number_field: the width caps and the points differ in size");
+    for (double c : width_caps)
+      if (!(c >= 0.0))
+        throw std::invalid_argument("Winding_number_field: a width cap is negative or NaN");
     if (points.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max()))
       throw std::length_error("Winding_number_field: more than 2^32 - 2 points");
     if (leaf_size < 1)
@@ -306,6 +332,7 @@ public:
           len2 += s.an[c] * s.an[c];
         }
         s.area = areas[i];
+        s.width2 = width_caps.empty() ? s.area : std::min(s.area, width_caps[i] * width_caps[i]);
         s.index = std::uint32_t(i);
         const double scale = (len2 > 0.0 && std::isfinite(len2)) ? s.area / std::sqrt(len2) : 0.0;
         for (double& c : s.an)
@@ -340,8 +367,15 @@ public:
   }
   /// the smoothing factor f
   double smoothing_factor() const { return factor_; }
-  /// the smoothing width eps_i = f sqrt(a_i) of point i (an index of the build input)
-  double smoothing_width(std::size_t i) const { return factor_ * std::sqrt(sample(i).area); }
+  /// the smoothing width eps_i = f min(sqrt(a_i), its cap) of point i (an index of the build input)
+  double smoothing_width(std::size_t i) const { return factor_ * std::sqrt(sample(i).width2); }
+  /// the cap of the smoothing width of point i given to `build()`, where it
+  /// is below sqrt(a_i); +inf elsewhere
+  double width_cap(std::size_t i) const
+  {
+    const internal::Winding_sample& s = sample(i);
+    return s.width2 < s.area ? std::sqrt(s.width2) : HUGE_VAL;
+  }
 
   /// Negates the normals of the points whose indices (in the build input)
   /// `indices` lists, each at most once, and updates the tree's moments.
@@ -515,7 +549,7 @@ public:
     internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
       for (std::size_t t = b; t < e; ++t) { // in tree order: coherent
         double F[3];
-        tree_.charge_field(samples[t].p, beta2, f2 * samples[t].area, F);
+        tree_.charge_field(samples[t].p, beta2, f2 * samples[t].width2, F);
         derivatives[samples[t].index] = Vector_3(F[0] * s, F[1] * s, F[2] * s);
       }
     }, 64);

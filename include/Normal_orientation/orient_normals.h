@@ -500,11 +500,11 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       // 2. Graph, with the edges across two layers negated.
       Neighbor_graph graph;
       std::vector<internal::Layer_offset> layer_offsets;
-      const Neighbor_graph_report gr =
-        build_neighbor_graph<ConcurrencyTag, Kernel>(in.points, in.normals, settings.number_of_neighbors,
-                                                     settings.neighbor_radius, criterion, graph,
-                                                     progress.part(Stage::GRAPH, 0.0, 0.8), settings.layer_edges,
-                                                     &layer_offsets);
+      std::vector<std::uint8_t> layer_gaps; // (for the global stage's field)
+      const Neighbor_graph_report gr = build_neighbor_graph<ConcurrencyTag, Kernel>(
+        in.points, in.normals, settings.number_of_neighbors, settings.neighbor_radius, criterion, graph,
+        progress.part(Stage::GRAPH, 0.0, 0.8), settings.layer_edges, &layer_offsets,
+        policies.global.orientation != Global_orientation::NONE ? &layer_gaps : nullptr);
       internal::add_graph_report(gr, result);
       const auto weight = get(&Neighbor_edge::weight, graph);
       const internal::Layer_pairs layer_pairs = internal::core_layer_pairs(layer_offsets, graph, weight);
@@ -552,7 +552,8 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
           progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
           result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(
             graph, in.points, in.normals, component, gr.radius, has_unary, cued, cue_fixed, moved, global, labels,
-            &layer_pairs, want_cues && dense ? &cue_report : nullptr); // (no cues where noise hides the layers)
+            &layer_pairs, want_cues && dense ? &cue_report : nullptr, // (no cues where noise hides the layers)
+            &layer_gaps);
           result.seconds.global += result.global.seconds;
         }
       };

@@ -16,6 +16,7 @@
 #include <Normal_orientation/Winding_number_field.h>
 #include <Normal_orientation/internal/Core_layer_cues.h>
 #include <Normal_orientation/internal/Graph_reduction.h>
+#include <Normal_orientation/internal/Layer_gap.h>
 #include <Normal_orientation/internal/Parallel.h>
 #include <Normal_orientation/internal/Seen_side_rules.h>
 
@@ -324,6 +325,7 @@ struct Core_samples
   std::vector<typename Kernel::Point_3> points;    ///< their positions
   std::vector<typename Kernel::Vector_3> oriented; ///< their normals, oriented
   std::vector<double> areas;                       ///< their capped areas
+  std::vector<double> width_caps;                  ///< the caps of their smoothing widths (empty: none)
   std::vector<std::uint32_t> component;            ///< their components
 };
 
@@ -373,7 +375,7 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
 {
   const std::size_t n = points.size();
   Winding_patch_signs<Kernel> search;
-  search.template build<ConcurrencyTag>(samples.points, samples.oriented, samples.areas);
+  search.template build<ConcurrencyTag>(samples.points, samples.oriented, samples.areas, samples.width_caps);
   const double slope = patch_slope(slopes);
   for (double cell_radii : patch_cell_radii) {
     const bool reuse = cell_radii == 0.0 && !sheets.empty() && slope == sheet_slope;
@@ -424,7 +426,8 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
                                       const std::vector<char>& cue_fixed, const std::vector<char>& moved,
                                       const Global_settings& settings,
                                       std::vector<Label>& labels, const Layer_pairs* pairs = nullptr,
-                                      Layer_cue_report* cues = nullptr)
+                                      Layer_cue_report* cues = nullptr,
+                                      const std::vector<std::uint8_t>* layer_gaps = nullptr)
 {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = points.size();
@@ -432,6 +435,13 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   Core_samples<Kernel> samples =
     core_samples<ConcurrencyTag, Kernel>(points, normals, component, labels, settings.dense_samples);
   const std::size_t ns = samples.index.size();
+  if (layer_gaps != nullptr && layer_gaps->size() == n) {
+    std::vector<std::uint8_t> codes(ns);
+    for (std::size_t t = 0; t < ns; ++t)
+      codes[t] = (*layer_gaps)[samples.index[t]];
+    const std::size_t with_gap = n - std::size_t(std::count(layer_gaps->begin(), layer_gaps->end(), std::uint8_t(0)));
+    samples.width_caps = contact_width_caps(codes, with_gap, n, radius, samples.areas);
+  }
   std::size_t nc = 0;
   for (std::uint32_t c : component)
     nc = std::max<std::size_t>(nc, std::size_t(c) + 1);
@@ -546,6 +556,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   report.points_flipped = 0;
   for (std::size_t i = 0; i < n; ++i)
     report.points_flipped += labels_before[i] != labels[i] ? 1 : 0;
+  report.sharp_samples = sharp_samples(samples.width_caps);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }

@@ -25,12 +25,14 @@ namespace Normal_orientation {
 namespace internal {
 
 /// One sample of the field: position, a_i s_i n_i (area times signed unit
-/// normal), area a_i, and its index in the input.
+/// normal), area a_i, its squared smoothing width over the smoothing factor
+/// (a_i, or the square of a smaller cap), and its index in the input.
 struct Winding_sample
 {
   double p[3];
   double an[3];
   double area;
+  double width2;
   std::uint32_t index;
 };
 
@@ -40,7 +42,7 @@ struct Winding_node
 {
   double center[3];   // area-weighted centre c (the plain centroid when all areas are 0)
   double radius;      // max |p_i - c| over the node's samples
-  double mean_area;   // sum a_i^2 / sum a_i: the node's smoothing width is f^2 * mean_area
+  double mean_area;   // sum a_i width2_i / sum a_i: the node's squared smoothing width is f^2 * mean_area
   double dipole[3];   // N = sum a_i s_i n_i
   double second[9];   // M[l][k] = sum a_i (p_i - c)_l (s_i n_i)_k, row-major
   double third[18];   // Q[kl][j] = sum a_i (p_i - c)_k (p_i - c)_l (s_i n_i)_j, kl in 00 01 02 11 12 22
@@ -390,7 +392,7 @@ private:
       const double r[3] = {s.p[0] - q[0], s.p[1] - q[1], s.p[2] - q[2]};
       if (x2 > 0.0 && r[0] * r[0] + r[1] * r[1] + r[2] * r[2] < x2)
         continue;
-      Winding_kernel::add_sample<Gradient>(r, s.an, f2 * s.area, w, g);
+      Winding_kernel::add_sample<Gradient>(r, s.an, f2 * s.width2, w, g);
     }
   }
 
@@ -460,7 +462,7 @@ private:
     for (std::size_t t = b; t < e; ++t) {
       const Winding_sample& s = samples_[t];
       sum_a += s.area;
-      sum_a2 += s.area * s.area;
+      sum_a2 += s.area * s.width2;
       for (int k = 0; k < 3; ++k) {
         c[k] += s.area * s.p[k];
         plain[k] += s.p[k];

@@ -13,6 +13,7 @@
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Winding_number_field.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
+#include <Normal_orientation/internal/Layer_gap.h>
 #include <Normal_orientation/streaming/Labelled_records.h>
 #include <Normal_orientation/streaming/Patch_units.h>
 #include <Normal_orientation/streaming/Segmenting_sweep.h>
@@ -49,6 +50,7 @@ struct Global_samples
   std::vector<std::uint32_t> unit;                ///< patch unit (with `Patch_units`)
   std::vector<char> two_layers;                   ///< on two layers (`Swept_record::layer` not 0)
   std::vector<std::uint16_t> layer;               ///< `Swept_record::layer` (`layer_code()`)
+  std::vector<std::uint8_t> gap;                  ///< `Swept_record::gap` (`layer_gap_code()`)
   std::vector<signed char> sign;                  ///< the oriented normal over the input normal, +1 or -1
   std::vector<std::uint32_t> sweep_segment;       ///< the sweep's segment (`Swept_record::segment`)
   std::vector<signed char> sweep_flip;            ///< the sweep's flip in it (`Swept_record::flip`)
@@ -107,6 +109,7 @@ Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std
       out.unit.push_back(unit);
       out.two_layers.push_back(char(s.layer != 0));
       out.layer.push_back(s.layer);
+      out.gap.push_back(s.gap);
       out.sign.push_back(sign < 0.0 ? -1 : 1);
       out.sweep_segment.push_back(s.segment);
       out.sweep_flip.push_back(s.flip < 0 ? -1 : 1);
@@ -364,12 +367,15 @@ void stream_winding_levels(const Global_samples<Kernel>& samples, Winding_patch_
 /// `component` and `segment_has_unary` are per sweep segment.  With
 /// `cues`, the layer cues of the final signs go there
 /// (`stream_layer_cues()`), each as strong as `cue_strength` per point that
-/// its sample stands for.  Memory: the subsample, the units and
+/// its sample stands for.  The field's smoothing widths are capped at the
+/// samples' layer gaps (`contact_width_caps()`, with `layer_gap_points` of
+/// the `n` points having one).  Memory: the subsample, the units and
 /// O(segments).
 template <typename ConcurrencyTag>
 Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
                                  const std::vector<std::uint32_t>& component, std::vector<char>& flip_component,
                                  const std::vector<char>& segment_has_unary, double radius, std::uint64_t n,
+                                 std::uint64_t layer_gap_points,
                                  const Normal_orientation::internal::Global_settings& settings,
                                  const Progress_reporter& progress, const Unit_inputs& unit_inputs = Unit_inputs(),
                                  Stream_layer_cues* cues = nullptr, double cue_strength = 0.0)
@@ -400,6 +406,8 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   }
   std::vector<double> areas = estimate_point_areas<ConcurrencyTag>(samples.points, samples.normals);
   Normal_orientation::internal::cap_areas(areas);
+  const std::vector<double> width_caps =
+    Normal_orientation::internal::contact_width_caps(samples.gap, layer_gap_points, n, radius, areas);
   // Exterior visibility first: whole components negate in flip_component,
   // sheets and segments through the samples and the units.
   const std::size_t nc = flip_component.size();
@@ -418,7 +426,7 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
     if (seen.seen.component[samples.component[j]] != sample_flip[j])
       oriented[j] = -oriented[j];
   Winding_patch_signs<Kernel> search;
-  search.template build<ConcurrencyTag>(samples.points, oriented, areas);
+  search.template build<ConcurrencyTag>(samples.points, oriented, areas, width_caps);
   stream_winding_levels<ConcurrencyTag>(samples, search, units.get(), segment_patch, segment_first, radius,
                                         has_unary, sample_flip, unit_flip, report);
   // The winding number's flips against both the solver and visibility, in
@@ -468,6 +476,7 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   report.visibility = settings.orientation == Normal_orientation::Global_orientation::VISIBILITY_AND_WINDING;
   report.seen_components_flipped = seen.seen.components_flipped;
   report.seen_patches_flipped = seen.seen.patches_flipped;
+  report.sharp_samples = Normal_orientation::internal::sharp_samples(width_caps);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   progress.report(4, 4);
   return report;

@@ -345,7 +345,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
       Normal_orientation::internal::Global_settings g = global;
       g.dense_samples = dense;
       result.global = global_stage<ConcurrencyTag>(points, labels, solution.component, flip_component, has_unary,
-                                                   radius, n, g, stage(Stage::GLOBAL),
+                                                   radius, n, swept.layer_gap_points, g, stage(Stage::GLOBAL),
                                                    Unit_inputs{edges.get(), result.edge_span,
                                                                settings.temporary_directory},
                                                    want_cues && dense && !cue_round ? &cues : nullptr, double(k));

@@ -14,6 +14,7 @@
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Segmenter.h>
 #include <Normal_orientation/internal/Layer_edges.h>
+#include <Normal_orientation/internal/Layer_gap.h>
 #include <Normal_orientation/internal/Parallel.h>
 #include <Normal_orientation/internal/Unit_vector.h>
 #include <Normal_orientation/streaming/Record_file.h>
@@ -40,7 +41,8 @@ struct Swept_record
 {
   Point_record record;
   std::uint32_t segment;
-  std::int16_t flip;
+  std::int8_t flip;
+  std::uint8_t gap;    ///< `layer_gap_code()`: 0 without a neighbour on another layer
   std::uint16_t layer; ///< `layer_code()`: 0 on one layer
 };
 
@@ -75,6 +77,7 @@ struct Sweep_payload
   Label flip = 1;
   unsigned char layer_state = 0; ///< how `layer` was found (`Layer_fit_state`)
   Normal_orientation::internal::Layer_offset layer{}; ///< the layer offset (`build_neighbor_graph()`)
+  std::uint8_t gap = 0; ///< the layer gap's code (`build_neighbor_graph()`)
 };
 
 /// unit normal of a record (zero when the normal is zero)
@@ -94,6 +97,7 @@ struct Sweep_stage_result
   double energy_before = 0.0;        ///< the energy of the input orientation, summed in the sweep order
   double total_weight = 0.0;         ///< the sum of the edges' absolute weights, in the sweep order
   std::uint64_t two_layer_points = 0; ///< points on two layers (`build_neighbor_graph()`)
+  std::uint64_t layer_gap_points = 0; ///< points with a layer gap (`build_neighbor_graph()`)
 };
 
 /// The visitor of `sweep()` for the streaming driver.  `Unary` is callable
@@ -125,6 +129,15 @@ public:
   {
     m_progress.report(first, m_n); // `first` points are finalised
     const std::size_t count = offsets.size() - 1;
+    // The layer gaps, from every point's own k nearest (as in core): in the
+    // fit's first gather, whose loads they share, else in a loop of their own.
+    const double radius = std::sqrt(m_r2);
+    m_gaps.assign(count, 0);
+    m_gap_done.assign(count, 0);
+    auto gap_of = [&](const Point_record& p, double& gap, std::uint64_t j) {
+      const Point_record& o = w.record(j);
+      gap = std::min(gap, Normal_orientation::internal::layer_gap_to(p.position, p.normal, o.position, o.normal));
+    };
     if (m_layer_edges) {
       Normal_orientation::internal::fit_layer_offsets<ConcurrencyTag>(
         count,
@@ -136,7 +149,12 @@ public:
           }
         },
         [&](std::size_t q, auto&& f) {
+          const bool measure = !m_gap_done[q]; // (the first pass visits every point first)
+          const Point_record& p = w.record(first + q);
+          double gap = HUGE_VAL;
           nearest.for_each(q, [&](std::uint64_t j, float) {
+            if (measure)
+              gap_of(p, gap, j);
             if (j >= first && j < first + count)
               f(w.record(j).position, std::size_t(j - first), Normal_orientation::internal::ONE_LAYER, m_none);
             else if (j < first)
@@ -146,9 +164,21 @@ public:
               f(w.record(j).position, Normal_orientation::internal::no_local, Normal_orientation::internal::ONE_LAYER,
                 m_none);
           });
+          if (measure) {
+            m_gaps[q] = Normal_orientation::internal::layer_gap_code(gap, radius);
+            m_gap_done[q] = 1;
+          }
         },
         m_layers, m_states);
     } else {
+      Normal_orientation::internal::parallel_chunks<ConcurrencyTag>(count, [&](std::size_t b, std::size_t e) {
+        for (std::size_t q = b; q < e; ++q) {
+          const Point_record& p = w.record(first + q);
+          double gap = HUGE_VAL;
+          nearest.for_each(q, [&](std::uint64_t j, float) { gap_of(p, gap, j); });
+          m_gaps[q] = Normal_orientation::internal::layer_gap_code(gap, radius);
+        }
+      }, 256);
       m_layers.assign(count, m_none);
       m_states.assign(count, Normal_orientation::internal::ONE_LAYER);
     }
@@ -159,6 +189,8 @@ public:
       const bool two = Normal_orientation::internal::is_two_layers(m_layers[q]);
       m_out.two_layer_points += two ? 1 : 0;
       m_window_two_layers += two ? 1 : 0;
+      payload.gap = m_gaps[q];
+      m_out.layer_gap_points += m_gaps[q] != 0 ? 1 : 0;
     }
     const bool any_two_layers = m_window_two_layers > 0; // (else no edge of the batch crosses layers)
     m_weights.resize(neighbors.size());
@@ -231,7 +263,7 @@ public:
   {
     const Sweep_payload& p = w.payload(s);
     m_window_two_layers -= Normal_orientation::internal::is_two_layers(p.layer) ? 1 : 0;
-    m_records.append(Swept_record{w.record(s), p.segment, std::int16_t(p.flip),
+    m_records.append(Swept_record{w.record(s), p.segment, std::int8_t(p.flip), p.gap,
                                   layer_code(p.layer, unit_normal(w.record(s)), std::sqrt(m_r2))});
   }
 
@@ -250,6 +282,8 @@ private:
   std::vector<float> m_weights;
   std::vector<Normal_orientation::internal::Layer_offset> m_layers;
   std::vector<unsigned char> m_states;
+  std::vector<std::uint8_t> m_gaps;   // (per point of the batch, `layer_gap_code()`)
+  std::vector<char> m_gap_done;
   const Normal_orientation::internal::Layer_offset m_none{};
   std::uint64_t m_window_two_layers = 0; // two-layer points in the window
   std::size_t m_cursor = 0;
