@@ -9,6 +9,7 @@
 #include <Normal_orientation/Exterior_visibility.h>
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
+#include <Normal_orientation/internal/Frustrated_islands.h>
 #include <Normal_orientation/internal/Layer_edges.h>
 #include <Normal_orientation/internal/Two_layer_fit.h>
 #include <Normal_orientation/orient_normals.h>
@@ -36,6 +37,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numeric>
 #include <random>
 #include <string>
 #include <stdexcept>
@@ -235,6 +237,81 @@ TEST(Global_sign, DecidePatchSignsFixesInvertedPatchesOfAClosedSurface)
   EXPECT_THROW(NO::decide_patch_signs(p, n, a, bad, component, {}, flip), std::invalid_argument);
   EXPECT_THROW(NO::decide_patch_signs(p, n, a, patch, component, std::vector<char>(3, 0), flip),
                std::invalid_argument);
+}
+
+TEST(Global_sign, FrustratedIslandsAreNegatedWhereTheFieldAgrees)
+{
+  // A sampled sphere whose cap (1.5% of its area) has the other sign from
+  // the rest: its border weighs wholly against it.  When the cap is the
+  // inverted part, w is 1/2 - f on the sphere (f its area fraction), and
+  // negating it brings w to 1/2: it is negated.  When the rest is inverted,
+  // negating the cap brings w from -1/2 + f to -1/2, so the field rises and
+  // the cap stays.  Points to keep keep their island.
+  std::mt19937_64 rng(3);
+  std::vector<Sample> s = NO::test::sphere(3000, rng);
+  // (segments grow from earlier neighbours: an order along the sphere, as
+  // the drivers' spatial order)
+  std::sort(s.begin(), s.end(), [](const Sample& a, const Sample& b) { return a.p.z() > b.p.z(); });
+  const std::size_t n = s.size(), k = 10;
+  NO::internal::Array_problem problem;
+  problem.number_of_vertices = n;
+  for (std::size_t i = 0; i < n; ++i) { // (k nearest, brute force; weights n_i . n_j > 0)
+    std::vector<std::pair<double, std::uint32_t>> d;
+    for (std::size_t j = 0; j < n; ++j)
+      if (j != i)
+        d.emplace_back(CGAL::squared_distance(s[i].p, s[j].p), std::uint32_t(j));
+    std::partial_sort(d.begin(), d.begin() + k, d.end());
+    for (std::size_t t = 0; t < k; ++t) {
+      problem.tail.push_back(std::uint32_t(i));
+      problem.head.push_back(d[t].second);
+      problem.weight.push_back(s[i].n * s[d[t].second].n);
+    }
+  }
+  const NO::internal::Incidence inc(problem);
+  std::vector<Point> points;
+  for (const Sample& t : s)
+    points.push_back(t.p);
+  const std::vector<double> areas(n, 4.0 * M_PI / double(n));
+  std::vector<std::uint32_t> index(n);
+  std::iota(index.begin(), index.end(), 0u);
+  auto cap = [&](std::size_t i) { return s[i].p.z() > 0.97; };
+  auto run = [&](int cap_label, const std::vector<char>& keep, std::vector<NO::Label>& labels) {
+    labels.assign(n, NO::Label(-cap_label));
+    for (std::size_t i = 0; i < n; ++i)
+      if (cap(i))
+        labels[i] = NO::Label(cap_label);
+    std::vector<Vector> oriented;
+    for (std::size_t i = 0; i < n; ++i)
+      oriented.push_back(labels[i] > 0 ? s[i].n : -s[i].n);
+    NO::Winding_patch_signs<Kernel> search;
+    search.build(points, oriented, areas);
+    const double before = search.energy();
+    const std::size_t negated =
+      NO::internal::negate_frustrated_islands<CGAL::Sequential_tag, Kernel>(inc, index, keep, search, labels);
+    EXPECT_LE(search.energy(), before + 1e-12);
+    return negated;
+  };
+  std::size_t in_cap = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    in_cap += cap(i) ? 1 : 0;
+  ASSERT_GT(in_cap, 20u);
+  std::vector<NO::Label> labels;
+  EXPECT_EQ(run(-1, {}, labels), 1u); // the inverted cap is negated
+  EXPECT_EQ(std::count(labels.begin(), labels.end(), NO::Label(1)), std::ptrdiff_t(n));
+  EXPECT_EQ(run(1, {}, labels), 0u); // the right cap of an inverted sphere stays
+  for (std::size_t i = 0; i < n; ++i)
+    EXPECT_EQ(labels[i], cap(i) ? 1 : -1);
+  std::vector<char> keep(n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (cap(i)) {
+      keep[i] = 1; // (one point of the cap)
+      break;
+    }
+  EXPECT_EQ(run(-1, keep, labels), 0u); // a kept point keeps its island
+  // the rule of an island: most of its border against it, less than half the points
+  EXPECT_TRUE(NO::internal::is_island(9.0, 1.0, 10, 100));
+  EXPECT_FALSE(NO::internal::is_island(7.0, 3.0, 10, 100));
+  EXPECT_FALSE(NO::internal::is_island(9.0, 1.0, 50, 100));
 }
 
 TEST(Global_sign, WholeSheetsNeedLessEvidence)

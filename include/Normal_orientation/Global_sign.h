@@ -288,6 +288,37 @@ public:
   /// E = sum_j a_j (w_j - 1/2)^2 with the signs chosen so far
   double energy() const { return m_energy; }
 
+  /// Negates the samples `indices` (the labels changed outside the search,
+  /// e.g. by a veto) and evaluates w at every sample again.
+  /// \throw std::out_of_range if an index is not that of a sample
+  template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
+  void negate_samples(const std::vector<std::uint32_t>& indices)
+  {
+    m_field.negate(indices);
+    m_energy = internal::winding_energy<ConcurrencyTag>(m_field, m_points, m_areas, m_w);
+  }
+
+  /// Negates the samples `members` (one patch) in the field when that
+  /// changes E by less than `most_change` per unit of their area (0: only
+  /// when E falls), and returns whether it did.  w moves by the patch's own
+  /// field, as in `decide()`.
+  template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag>
+  bool negate_unless_worse(const std::vector<std::uint32_t>& members, double most_change = 0.0)
+  {
+    std::vector<float> own;
+    const double d = internal::negation_change<ConcurrencyTag, Kernel>(m_field, m_points, m_areas, m_w, members, own);
+    double area = 0.0;
+    for (std::uint32_t j : members)
+      area += m_areas[j];
+    if (!(d < most_change * area))
+      return false;
+    m_field.negate(members);
+    for (std::size_t j = 0; j < m_w.size(); ++j)
+      m_w[j] -= 2.0 * double(own[j]);
+    m_energy += d;
+    return true;
+  }
+
   /// Decides the signs of the patches of one partition (the parameters are
   /// those of `decide_patch_signs()`) and keeps them in the field.
   template <typename ConcurrencyTag = CGAL::Parallel_if_available_tag>

@@ -42,6 +42,10 @@ struct Global_sign_summary
   /// the samples whose smoothing width was capped at their layer gap (the
   /// manual's *Sharp field at contacts*; `Winding_number_field::build()`)
   std::size_t sharp_samples = 0;
+  /// the islands, segments of the final signs whose border weighs mostly
+  /// against them, that the stage negated last where the field agreed (the
+  /// manual's *Islands left by the stage*; in core only, 0 streamed)
+  std::size_t islands_flipped = 0;
   /// the fraction of the sampled area where w is within the tolerance of
   /// 1/2, after the stage: near 1 on closed surfaces, low on open scans
   double closedness = std::numeric_limits<double>::quiet_NaN();

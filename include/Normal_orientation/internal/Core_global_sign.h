@@ -15,6 +15,7 @@
 #include <Normal_orientation/Signed_union_find.h>
 #include <Normal_orientation/Winding_number_field.h>
 #include <Normal_orientation/internal/Core_layer_cues.h>
+#include <Normal_orientation/internal/Frustrated_islands.h>
 #include <Normal_orientation/internal/Graph_reduction.h>
 #include <Normal_orientation/internal/Layer_gap.h>
 #include <Normal_orientation/internal/Parallel.h>
@@ -301,20 +302,6 @@ inline void add_level(Global_sign_summary& total, const Global_sign_summary& lev
   total.energy_after = level.energy_after;
 }
 
-/// The segments of the labelling `labels` on the graph of incidence lists
-/// `inc` (`reduce_to_segments()`: the paper's segmentation with its default
-/// thresholds, in vertex order, in the frame where `labels` is all +1):
-/// regions that the labelling made consistent, as the streamed driver's
-/// final segments are.  Writes the segment of every vertex to `segment`;
-/// returns their number.
-inline std::size_t labelling_segments(const Incidence& inc, const std::vector<Label>& labels,
-                                      std::vector<std::uint32_t>& segment)
-{
-  Segment_reduction r = reduce_to_segments(inc, std::vector<double>(), labels);
-  segment = std::move(r.segment);
-  return r.reduced.number_of_vertices;
-}
-
 /// The samples of the in-core global stage: every stride-th point of the
 /// Morton order with a normal (an even subsample), oriented by `labels`.
 template <typename Kernel>
@@ -363,7 +350,8 @@ Core_samples<Kernel> core_samples(const std::vector<typename Kernel::Point_3>& p
 /// `labels` and adds the figures to `report`.  `sheets` (`number_of_sheets`
 /// of them, of slope at most `sheet_slope`) are the first level's patches
 /// when `labels` has not changed since they were built and the slopes agree,
-/// else empty; `moved` is that of `build_patches()`.
+/// else empty; `moved` is that of `build_patches()`.  `search` is built
+/// here, on `samples`, and keeps the signs chosen.
 template <typename ConcurrencyTag, typename Kernel>
 void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                          const std::vector<typename Kernel::Vector_3>& normals, const std::vector<float>& slopes,
@@ -371,10 +359,10 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
                          const std::vector<char>& has_unary, const std::vector<char>& moved,
                          const Core_samples<Kernel>& samples,
                          const std::vector<std::uint32_t>& sheets, std::size_t number_of_sheets,
-                         std::vector<Label>& labels, Global_sign_summary& report)
+                         std::vector<Label>& labels, Global_sign_summary& report,
+                         Winding_patch_signs<Kernel>& search)
 {
   const std::size_t n = points.size();
-  Winding_patch_signs<Kernel> search;
   search.template build<ConcurrencyTag>(samples.points, samples.oriented, samples.areas, samples.width_caps);
   const double slope = patch_slope(slopes);
   for (double cell_radii : patch_cell_radii) {
@@ -474,10 +462,9 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   std::vector<std::uint32_t> segment, sample_segment(ns);
   std::size_t number_of_segments = 0;
   std::vector<char> segment_flip;
-  if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING) {
-    const Incidence inc(graph, get(&Neighbor_edge::weight, graph), "the global stage");
+  const Incidence inc(graph, get(&Neighbor_edge::weight, graph), "the global stage"); // (segments, islands)
+  if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING)
     number_of_segments = labelling_segments(inc, labels, segment);
-  }
   if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING) {
     for (std::size_t t = 0; t < ns; ++t)
       sample_segment[t] = segment[samples.index[t]];
@@ -512,9 +499,10 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
     for (std::size_t i = 0; i < n; ++i)
       keep[i] = char(keep[i] || cued[i]);
   }
+  Winding_patch_signs<Kernel> search;
   core_winding_levels<ConcurrencyTag, Kernel>(graph, points, normals, slopes, component, radius, keep,
                                               moved, samples, unchanged ? sheet : std::vector<std::uint32_t>(),
-                                              number_of_sheets, labels, report);
+                                              number_of_sheets, labels, report, search);
   // 3. Its flips against both the solver and visibility, in the sheets they
   // turn away from where they were seen, are undone.
   auto by_visibility = [&](std::size_t i) { return char(seen_labels[i] != labels_before[i]); };
@@ -526,10 +514,20 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   }
   const std::vector<char> veto = seen_side_vetoes(seen.vote, samples.areas, sample_sheet, sample_by_visibility,
                                                   sample_by_winding, number_of_sheets);
+  std::vector<std::uint32_t> vetoed; // (samples)
+  for (std::size_t t = 0; t < ns; ++t) {
+    const std::size_t i = samples.index[t];
+    if (veto[sheet[i]] && negated_against_both(by_visibility(i), by_winding(i)))
+      vetoed.push_back(std::uint32_t(t));
+  }
   for (std::size_t i = 0; i < n; ++i)
     if (veto[sheet[i]] && negated_against_both(by_visibility(i), by_winding(i)))
       labels[i] = seen_labels[i];
-  // 4. Components whose top surface faces down are negated.
+  // 4. Islands left against their surroundings, where the field agrees.
+  if (!vetoed.empty())
+    search.template negate_samples<ConcurrencyTag>(vetoed);
+  report.islands_flipped = negate_frustrated_islands<ConcurrencyTag, Kernel>(inc, samples.index, keep, search, labels);
+  // 5. Components whose top surface faces down are negated.
   for (std::size_t t = 0; t < ns; ++t)
     samples.oriented[t] = labels[samples.index[t]] < 0 ? -normals[samples.index[t]] : normals[samples.index[t]];
   for (std::size_t c = 0; c < nc; ++c)
@@ -541,7 +539,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
       labels[i] = Label(-labels[i]);
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
-  // 5. The layer cues of the final signs.
+  // 6. The layer cues of the final signs.
   if (cues && pairs) {
     for (std::size_t t = 0; t < ns; ++t)
       if (top[samples.component[t]])

@@ -277,6 +277,20 @@ inline Segment_reduction reduce_to_segments(const Incidence& inc, const std::vec
   return r;
 }
 
+/// The segments of the labelling `labels` on the graph of incidence lists
+/// `inc` (`reduce_to_segments()`: the paper's segmentation with its default
+/// thresholds, in vertex order, in the frame where `labels` is all +1):
+/// regions that the labelling made consistent, as the streamed driver's
+/// final segments are.  Writes the segment of every vertex to `segment`;
+/// returns their number.
+inline std::size_t labelling_segments(const Incidence& inc, const std::vector<Label>& labels,
+                                      std::vector<std::uint32_t>& segment)
+{
+  Segment_reduction r = reduce_to_segments(inc, std::vector<double>(), labels);
+  segment = std::move(r.segment);
+  return r.reduced.number_of_vertices;
+}
+
 } // namespace internal
 } // namespace Normal_orientation
 
