@@ -14,6 +14,7 @@
 #include <Normal_orientation/internal/Two_layer_fit.h>
 #include <Normal_orientation/orient_normals.h>
 #include <Normal_orientation/streaming/Patch_units.h>
+#include <Normal_orientation/streaming/Unit_islands.h>
 
 #include <CGAL/pca_estimate_normals.h>
 
@@ -239,25 +240,20 @@ TEST(Global_sign, DecidePatchSignsFixesInvertedPatchesOfAClosedSurface)
                std::invalid_argument);
 }
 
-TEST(Global_sign, FrustratedIslandsAreNegatedWhereTheFieldAgrees)
+namespace {
+
+/// A sampled sphere sorted by z (segments grow from earlier neighbours: an
+/// order along the sphere, as the drivers' spatial order) and its k nearest
+/// neighbours, brute force, with the weights n_i . n_j > 0.
+std::vector<Sample> sorted_sphere(std::size_t n, std::size_t k, NO::internal::Array_problem& problem)
 {
-  // A sampled sphere whose cap (1.5% of its area) has the other sign from
-  // the rest: its border weighs wholly against it.  When the cap is the
-  // inverted part, w is 1/2 - f on the sphere (f its area fraction), and
-  // negating it brings w to 1/2: it is negated.  When the rest is inverted,
-  // negating the cap brings w from -1/2 + f to -1/2, so the field rises and
-  // the cap stays.  Points to keep keep their island.
   std::mt19937_64 rng(3);
-  std::vector<Sample> s = NO::test::sphere(3000, rng);
-  // (segments grow from earlier neighbours: an order along the sphere, as
-  // the drivers' spatial order)
+  std::vector<Sample> s = NO::test::sphere(n, rng);
   std::sort(s.begin(), s.end(), [](const Sample& a, const Sample& b) { return a.p.z() > b.p.z(); });
-  const std::size_t n = s.size(), k = 10;
-  NO::internal::Array_problem problem;
-  problem.number_of_vertices = n;
-  for (std::size_t i = 0; i < n; ++i) { // (k nearest, brute force; weights n_i . n_j > 0)
+  problem.number_of_vertices = s.size();
+  for (std::size_t i = 0; i < s.size(); ++i) {
     std::vector<std::pair<double, std::uint32_t>> d;
-    for (std::size_t j = 0; j < n; ++j)
+    for (std::size_t j = 0; j < s.size(); ++j)
       if (j != i)
         d.emplace_back(CGAL::squared_distance(s[i].p, s[j].p), std::uint32_t(j));
     std::partial_sort(d.begin(), d.begin() + k, d.end());
@@ -267,6 +263,22 @@ TEST(Global_sign, FrustratedIslandsAreNegatedWhereTheFieldAgrees)
       problem.weight.push_back(s[i].n * s[d[t].second].n);
     }
   }
+  return s;
+}
+
+} // namespace
+
+TEST(Global_sign, FrustratedIslandsAreNegatedWhereTheFieldAgrees)
+{
+  // A sampled sphere whose cap (1.5% of its area) has the other sign from
+  // the rest: its border weighs wholly against it.  When the cap is the
+  // inverted part, w is 1/2 - f on the sphere (f its area fraction), and
+  // negating it brings w to 1/2: it is negated.  When the rest is inverted,
+  // negating the cap brings w from -1/2 + f to -1/2, so the field rises and
+  // the cap stays.  Points to keep keep their island.
+  NO::internal::Array_problem problem;
+  const std::vector<Sample> s = sorted_sphere(3000, 10, problem);
+  const std::size_t n = s.size();
   const NO::internal::Incidence inc(problem);
   std::vector<Point> points;
   for (const Sample& t : s)
@@ -312,6 +324,60 @@ TEST(Global_sign, FrustratedIslandsAreNegatedWhereTheFieldAgrees)
   EXPECT_TRUE(NO::internal::is_island(9.0, 1.0, 10, 100));
   EXPECT_FALSE(NO::internal::is_island(7.0, 3.0, 10, 100));
   EXPECT_FALSE(NO::internal::is_island(9.0, 1.0, 50, 100));
+}
+
+TEST(Global_sign, StreamedIslandsAreNegatedOnUnitsAsInCore)
+{
+  // The sphere of FrustratedIslandsAreNegatedWhereTheFieldAgrees, pushed
+  // into patch units in its order with its earlier edges: the islands of
+  // the units follow the same rule.
+  NO::internal::Array_problem problem;
+  const std::vector<Sample> s = sorted_sphere(3000, 10, problem);
+  const std::size_t n = s.size();
+  std::vector<std::vector<NO::streaming::Earlier_edge>> earlier(n);
+  std::uint64_t span = 1;
+  for (std::size_t t = 0; t < problem.tail.size(); ++t) { // (each edge once, at its later end)
+    const std::uint32_t a = std::min(problem.tail[t], problem.head[t]), b = std::max(problem.tail[t], problem.head[t]);
+    auto& list = earlier[b];
+    if (std::none_of(list.begin(), list.end(), [&](const auto& e) { return e.offset == b - a; }))
+      list.push_back({b - a, float(problem.weight[t])});
+    span = std::max<std::uint64_t>(span, b - a);
+  }
+  auto cap = [&](std::size_t i) { return s[i].p.z() > 0.97; };
+  std::vector<Point> points;
+  for (const Sample& t : s)
+    points.push_back(t.p);
+  const std::vector<double> areas(n, 4.0 * M_PI / double(n));
+  auto run = [&](int cap_sign, std::vector<char>& point_negated) {
+    // pushed with the cap of sign cap_sign, the rest the other; each point
+    // its own sample
+    NO::streaming::internal::Patch_units units(span, 0.2);
+    std::vector<std::uint32_t> unit(n);
+    std::vector<Vector> oriented;
+    for (std::size_t i = 0; i < n; ++i) {
+      const int sign = cap(i) ? cap_sign : -cap_sign;
+      oriented.push_back(sign > 0 ? s[i].n : -s[i].n);
+      unit[i] = units.push(s[i].p, oriented.back(), cap(i) ? 1u : 0u, 0u, earlier[i].data(), earlier[i].size(), sign);
+    }
+    EXPECT_FALSE(units.overflowed());
+    NO::Winding_patch_signs<Kernel> search;
+    search.build(points, oriented, areas);
+    const double before = search.energy();
+    std::vector<char> negated(units.number_of_units(), 0);
+    point_negated.assign(n, 0);
+    const std::size_t count = NO::streaming::internal::negate_unit_islands<CGAL::Sequential_tag, Kernel>(
+      units, n, unit, search, negated, point_negated);
+    EXPECT_LE(search.energy(), before + 1e-12);
+    for (std::size_t i = 0; i < n; ++i)
+      EXPECT_EQ(point_negated[i], negated[unit[i]]);
+    return count;
+  };
+  std::vector<char> negated;
+  EXPECT_EQ(run(-1, negated), 1u); // the inverted cap is negated, and only it
+  for (std::size_t i = 0; i < n; ++i)
+    EXPECT_EQ(negated[i], char(cap(i))) << i;
+  EXPECT_EQ(run(1, negated), 0u); // the right cap of an inverted sphere stays
+  EXPECT_EQ(std::count(negated.begin(), negated.end(), char(1)), 0);
 }
 
 TEST(Global_sign, WholeSheetsNeedLessEvidence)

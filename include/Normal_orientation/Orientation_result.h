@@ -44,7 +44,8 @@ struct Global_sign_summary
   std::size_t sharp_samples = 0;
   /// the islands, segments of the final signs whose border weighs mostly
   /// against them, that the stage negated last where the field agreed (the
-  /// manual's *Islands left by the stage*; in core only, 0 streamed)
+  /// manual's *Islands left by the stage*; streamed, segments of patch
+  /// units, and 0 where the stage has no units)
   std::size_t islands_flipped = 0;
   /// the fraction of the sampled area where w is within the tolerance of
   /// 1/2, after the stage: near 1 on closed surfaces, low on open scans

@@ -58,12 +58,55 @@ inline bool is_island(double against, double along, std::size_t size, std::size_
   return 2 * size < n && against > along && against >= island_frustration * (against + along);
 }
 
-/// Negates the islands of `labels` on the graph `inc` where the field of
-/// `search` (built on the samples `sample_index`, points with the signs
-/// `labels`) does not rise; an island without a sample follows its border
-/// alone.  Points of `keep` (per point, or empty) and their segments keep
-/// their signs.  Islands are taken by their border's excess, largest first,
-/// at most one among neighbours per round.  Returns the islands negated.
+/// The segments that the island rule looks at, in either driver: per
+/// segment the weight of its border against and for its signs, its points,
+/// whether it keeps its signs, and its samples (indices in the field).
+struct Island_segments
+{
+  std::vector<double> against, along;
+  std::vector<std::uint64_t> size;
+  std::vector<char> blocked;
+  std::vector<std::vector<std::uint32_t>> members;
+};
+
+/// The islands of `segments` (`is_island()` over `n` points) that the
+/// field of `search` lets negate: taken by their border's excess, largest
+/// first; an island is skipped when a neighbour negated before it in this
+/// round, or when it has samples and negating them would raise the winding
+/// energy (else they are negated in `search`); an island without a sample
+/// follows its border alone.  `neighbours(s, block)` calls `block(t)` for
+/// every segment t adjacent to s.  Returns the flags of the segments to
+/// negate (in `blocked`, the segments next to them are marked).
+template <typename ConcurrencyTag, typename Kernel, typename Neighbours>
+std::vector<char> choose_islands(Island_segments& segments, std::uint64_t n, Winding_patch_signs<Kernel>& search,
+                                 const Neighbours& neighbours)
+{
+  const std::size_t ns = segments.size.size();
+  std::vector<std::uint32_t> islands;
+  for (std::uint32_t s = 0; s < ns; ++s)
+    if (!segments.blocked[s] && is_island(segments.against[s], segments.along[s], segments.size[s], n))
+      islands.push_back(s);
+  std::stable_sort(islands.begin(), islands.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return segments.against[a] - segments.along[a] > segments.against[b] - segments.along[b];
+  });
+  std::vector<char> negate(ns, 0);
+  for (std::uint32_t s : islands) {
+    if (segments.blocked[s])
+      continue;
+    if (!segments.members[s].empty() && !search.template negate_unless_worse<ConcurrencyTag>(segments.members[s]))
+      continue;
+    negate[s] = 1;
+    neighbours(s, [&](std::uint32_t t) { segments.blocked[t] = 1; });
+  }
+  return negate;
+}
+
+/// Negates the islands of `labels` on the graph `inc` (its segments are
+/// `labelling_segments()`) where the field of `search` (built on the
+/// samples `sample_index`, points with the signs `labels`) does not rise
+/// (`choose_islands()`).  Points of `keep` (per point, or empty) and their
+/// segments keep their signs.  At most `island_rounds` rounds.  Returns the
+/// islands negated.
 template <typename ConcurrencyTag, typename Kernel>
 std::size_t negate_frustrated_islands(const Incidence& inc, const std::vector<std::uint32_t>& sample_index,
                                       const std::vector<char>& keep, Winding_patch_signs<Kernel>& search,
@@ -74,27 +117,18 @@ std::size_t negate_frustrated_islands(const Incidence& inc, const std::vector<st
   for (unsigned int round = 0; round < island_rounds; ++round) {
     std::vector<std::uint32_t> segment;
     const std::size_t ns = labelling_segments(inc, labels, segment);
-    std::vector<double> against, along;
-    island_borders(inc, labels, segment, ns, against, along);
-    std::vector<std::uint32_t> size(ns, 0);
-    std::vector<char> blocked(ns, 0);
+    Island_segments segments;
+    island_borders(inc, labels, segment, ns, segments.against, segments.along);
+    segments.size.assign(ns, 0);
+    segments.blocked.assign(ns, 0);
     for (std::size_t i = 0; i < n; ++i) {
-      ++size[segment[i]];
+      ++segments.size[segment[i]];
       if (!keep.empty() && keep[i])
-        blocked[segment[i]] = 1;
+        segments.blocked[segment[i]] = 1;
     }
-    std::vector<std::uint32_t> islands;
-    for (std::uint32_t s = 0; s < ns; ++s)
-      if (!blocked[s] && is_island(against[s], along[s], size[s], n))
-        islands.push_back(s);
-    if (islands.empty())
-      break;
-    std::stable_sort(islands.begin(), islands.end(), [&](std::uint32_t a, std::uint32_t b) {
-      return against[a] - along[a] > against[b] - along[b];
-    });
-    std::vector<std::vector<std::uint32_t>> members(ns);
+    segments.members.resize(ns);
     for (std::size_t t = 0; t < sample_index.size(); ++t)
-      members[segment[sample_index[t]]].push_back(std::uint32_t(t));
+      segments.members[segment[sample_index[t]]].push_back(std::uint32_t(t));
     std::vector<std::uint32_t> first(ns + 1, 0), order(n); // (the points of each segment)
     for (std::size_t i = 0; i < n; ++i)
       ++first[segment[i] + 1];
@@ -105,21 +139,13 @@ std::size_t negate_frustrated_islands(const Incidence& inc, const std::vector<st
       for (std::size_t i = 0; i < n; ++i)
         order[next[segment[i]]++] = std::uint32_t(i);
     }
-    std::vector<char> negate(ns, 0);
-    std::size_t this_round = 0;
-    for (std::uint32_t s : islands) {
-      if (blocked[s])
-        continue;
-      if (!members[s].empty() && !search.template negate_unless_worse<ConcurrencyTag>(members[s]))
-        continue;
-      negate[s] = 1;
-      ++this_round;
-      for (std::uint32_t q = first[s]; q < first[s + 1]; ++q) {
-        const std::uint32_t i = order[q];
-        for (std::uint32_t t = inc.first[i]; t < inc.first[i + 1]; ++t)
-          blocked[segment[inc.other[t]]] = 1;
-      }
-    }
+    const std::vector<char> negate =
+      choose_islands<ConcurrencyTag>(segments, n, search, [&](std::uint32_t s, const auto& block) {
+        for (std::uint32_t q = first[s]; q < first[s + 1]; ++q)
+          for (std::uint32_t t = inc.first[order[q]]; t < inc.first[order[q] + 1]; ++t)
+            block(segment[inc.other[t]]);
+      });
+    const std::size_t this_round = std::size_t(std::count(negate.begin(), negate.end(), char(1)));
     for (std::size_t i = 0; i < n; ++i)
       if (negate[segment[i]])
         labels[i] = Label(-labels[i]);

@@ -18,6 +18,7 @@
 #include <Normal_orientation/streaming/Patch_units.h>
 #include <Normal_orientation/streaming/Segmenting_sweep.h>
 #include <Normal_orientation/streaming/Stream_layer_cues.h>
+#include <Normal_orientation/streaming/Unit_islands.h>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 
@@ -97,7 +98,7 @@ Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std
         unit = units->push(Patch_units::Kernel::Point_3(s.record.position[0], s.record.position[1],
                                                         s.record.position[2]),
                            Patch_units::Kernel::Vector_3(sign * u[0], sign * u[1], sign * u[2]),
-                           points.segments()[q], c, point_edges, count);
+                           points.segments()[q], c, point_edges, count, sign < 0.0 ? -1 : 1);
         unit_file->append(unit);
       }
       if (at % stride != 0 || (u[0] == 0.0 && u[1] == 0.0 && u[2] == 0.0))
@@ -358,8 +359,9 @@ void stream_winding_levels(const Global_samples<Kernel>& samples, Winding_patch_
 /// The global stage on the labelled records, as in core on a subsample:
 /// exterior visibility (`stream_seen_sides()`), then the winding number
 /// (`Winding_patch_signs`) over three levels of patches
-/// (`stream_winding_levels()`), then the seen-side vetoes and the top
-/// surface.  With `unit_inputs.edges`, the patches are unions of units
+/// (`stream_winding_levels()`), then the seen-side vetoes, the islands
+/// (with units, `negate_unit_islands()`) and the top surface.  With
+/// `unit_inputs.edges`, the patches are unions of units
 /// (`Patch_units`), built in the pass that takes the samples, and every
 /// point follows its unit (a unit file installed in `labels`); else the
 /// points follow the samples (`Global_point_flips`).  Whole components
@@ -438,9 +440,12 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   }
   const std::vector<char> veto = Normal_orientation::internal::seen_side_vetoes(
     seen.seen.vote, areas, seen.sheet, by_visibility, by_winding, seen.number_of_sheets);
+  std::vector<std::uint32_t> vetoed; // (samples)
   for (std::size_t j = 0; j < ns; ++j)
-    if (veto[seen.sheet[j]] && Normal_orientation::internal::negated_against_both(by_visibility[j], by_winding[j]))
+    if (veto[seen.sheet[j]] && Normal_orientation::internal::negated_against_both(by_visibility[j], by_winding[j])) {
+      vetoed.push_back(std::uint32_t(j));
       sample_flip[j] = seen.sample[j];
+    }
   for (std::size_t u = 0; u < unit_flip.size(); ++u) {
     const char visible = seen.seen.component[units->unit_component()[u]] != seen.unit[u];
     if (veto[seen.unit_sheet[u]] &&
@@ -449,6 +454,23 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   }
   for (char v : veto)
     report.seen_vetoes += v ? 1 : 0;
+  // Islands left against their surroundings, where the field agrees (on
+  // the units; without them, none).
+  if (units) {
+    if (!vetoed.empty())
+      search.template negate_samples<ConcurrencyTag>(vetoed);
+    std::vector<char> negated(unit_flip.size()), sample_negated(ns);
+    for (std::size_t u = 0; u < negated.size(); ++u)
+      negated[u] = char(seen.seen.component[units->unit_component()[u]] != unit_flip[u]);
+    for (std::size_t j = 0; j < ns; ++j)
+      sample_negated[j] = char(seen.seen.component[samples.component[j]] != sample_flip[j]);
+    report.islands_flipped = negate_unit_islands<ConcurrencyTag, Kernel>(*units, n, samples.unit, search, negated,
+                                                                         sample_negated);
+    for (std::size_t u = 0; u < negated.size(); ++u)
+      unit_flip[u] = char(seen.seen.component[units->unit_component()[u]] != negated[u]);
+    for (std::size_t j = 0; j < ns; ++j)
+      sample_flip[j] = char(seen.seen.component[samples.component[j]] != sample_negated[j]);
+  }
   // Components whose top surface faces down are negated.
   for (std::size_t j = 0; j < ns; ++j)
     oriented[j] = seen.seen.component[samples.component[j]] != sample_flip[j] ? -samples.normals[j] : samples.normals[j];

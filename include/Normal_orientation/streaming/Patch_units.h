@@ -61,12 +61,13 @@ public:
   bool overflowed() const { return m_overflowed; }
 
   /// The next point in the sweep order: its position, its oriented normal
-  /// (zero: none), its final segment and component, and its earlier edges
-  /// `edges[0 .. count - 1]`; returns its unit.
+  /// (zero: none), its final segment and component, its earlier edges
+  /// `edges[0 .. count - 1]` and `sign`, +1 or -1, its oriented normal over
+  /// its input normal (the frame of the edges' weights); returns its unit.
   /// \throw std::runtime_error when an edge reaches before the first point or
   ///        farther back than the span
   std::uint32_t push(const Kernel::Point_3& p, const Kernel::Vector_3& m, std::uint32_t segment,
-                     std::uint32_t component, const Earlier_edge* edges, std::size_t count)
+                     std::uint32_t component, const Earlier_edge* edges, std::size_t count, int sign = 1)
   {
     const bool has_normal = m != CGAL::NULL_VECTOR;
     std::uint32_t sheet = no_sheet;
@@ -96,16 +97,23 @@ public:
         continue;
       const double s = e < kept ? slope[e] : Normal_orientation::internal::edge_slope(p, o.position, m, o.normal);
       ++m_histogram[std::min<std::size_t>(m_histogram.size() - 1, std::size_t(s * double(m_histogram.size())))];
-      if (o.unit == unit || o.component != component || s > Normal_orientation::internal::sheet_slope)
+      if (o.unit == unit)
+        continue;
+      const std::uint32_t a = std::min(unit, o.unit), b = std::max(unit, o.unit);
+      Pair& pair = m_pairs[(std::uint64_t(a) << 32) | b];
+      const float w = edges[e].weight * float(sign * o.sign);
+      pair.coupling += w;
+      pair.magnitude += std::abs(w);
+      if (o.component != component || s > Normal_orientation::internal::sheet_slope)
         continue;
       const double dot = CGAL::to_double(m * o.normal);
       if (dot > -0.5 && dot < 0.5)
         continue;
-      const std::uint32_t a = std::min(unit, o.unit), b = std::max(unit, o.unit);
-      auto it = m_pairs.emplace((std::uint64_t(a) << 32) | b, std::array<float, 2>{{2.0f, 2.0f}}).first;
-      float& least = it->second[dot >= 0.5 ? 0 : 1];
+      float& least = pair.least[dot >= 0.5 ? 0 : 1];
       least = std::min(least, float(s));
     }
+    if (!m_overflowed)
+      ++m_unit_size[unit];
     Point& slot = m_ring[std::size_t(m_at % m_ring.size())];
     slot.position = p;
     slot.normal = m;
@@ -113,6 +121,7 @@ public:
     slot.sheet = sheet;
     slot.component = component;
     slot.has_normal = has_normal;
+    slot.sign = sign < 0 ? -1 : 1;
     if (++m_at % 4096 == 0)
       m_split_slope = patch_slope();
     return unit;
@@ -124,6 +133,20 @@ public:
   const std::vector<std::uint32_t>& unit_segment() const { return m_unit_segment; }
   /// the component of every unit
   const std::vector<std::uint32_t>& unit_component() const { return m_unit_component; }
+  /// the points of every unit
+  const std::vector<std::uint32_t>& unit_size() const { return m_unit_size; }
+
+  /// Calls `f(a, b, coupling, magnitude)` for every pair of units a < b
+  /// joined by edges: the sum of their weights in the frame of the pushed
+  /// orientations, and the sum of their absolute values.  In an order that
+  /// depends only on the points pushed.
+  template <typename F>
+  void visit_couplings(F f) const
+  {
+    for (const auto& pair : m_pairs)
+      f(std::uint32_t(pair.first >> 32), std::uint32_t(pair.first & 0xFFFFFFFFu), double(pair.second.coupling),
+        double(pair.second.magnitude));
+  }
 
   /// The patches of the units with the negations `flip` (per unit, relative
   /// to the orientation pushed): the units united across their adjacencies
@@ -137,7 +160,7 @@ public:
     Signed_union_find sets(flip.size());
     for (const auto& pair : m_pairs) {
       const std::uint32_t a = std::uint32_t(pair.first >> 32), b = std::uint32_t(pair.first & 0xFFFFFFFFu);
-      if (double(pair.second[flip[a] != flip[b] ? 1 : 0]) > max_slope)
+      if (double(pair.second.least[flip[a] != flip[b] ? 1 : 0]) > max_slope)
         continue;
       if (level != 0 && !same_cell(a, b, level == 1 ? coarse_factor : 1))
         continue;
@@ -183,6 +206,15 @@ private:
     Kernel::Vector_3 normal;
     std::uint32_t unit = 0, sheet = 0, component = 0;
     bool has_normal = false;
+    signed char sign = 1;
+  };
+  /// the units joined by edges: the least slope of an edge between
+  /// oriented normals that agree [0] or are opposite [1] (2: none, or not
+  /// adjacent), the sum of the edges' weights and of their absolute values
+  struct Pair
+  {
+    std::array<float, 2> least{{2.0f, 2.0f}};
+    float coupling = 0.0f, magnitude = 0.0f;
   };
   typedef std::pair<std::uint64_t, std::uint64_t> Key;
   struct Key_hash
@@ -238,6 +270,7 @@ private:
       m_unit_cell.push_back(c);
       m_unit_segment.push_back(segment);
       m_unit_component.push_back(component);
+      m_unit_size.push_back(0);
     }
     m_last_key = key;
     m_last_unit = ins.first->second;
@@ -265,8 +298,8 @@ private:
   Key m_last_key;
   std::uint32_t m_last_unit = 0;
   std::vector<std::array<std::int32_t, 3>> m_unit_cell;
-  std::vector<std::uint32_t> m_unit_segment, m_unit_component;
-  std::unordered_map<std::uint64_t, std::array<float, 2>> m_pairs;
+  std::vector<std::uint32_t> m_unit_segment, m_unit_component, m_unit_size;
+  std::unordered_map<std::uint64_t, Pair> m_pairs;
 };
 
 } // namespace internal
