@@ -12,6 +12,7 @@
 #include <Normal_orientation/internal/Frustrated_islands.h>
 #include <Normal_orientation/internal/Layer_edges.h>
 #include <Normal_orientation/internal/Two_layer_fit.h>
+#include <Normal_orientation/internal/Undone_moves.h>
 #include <Normal_orientation/orient_normals.h>
 #include <Normal_orientation/streaming/Patch_units.h>
 #include <Normal_orientation/streaming/Unit_islands.h>
@@ -324,6 +325,73 @@ TEST(Global_sign, FrustratedIslandsAreNegatedWhereTheFieldAgrees)
   EXPECT_TRUE(NO::internal::is_island(9.0, 1.0, 10, 100));
   EXPECT_FALSE(NO::internal::is_island(7.0, 3.0, 10, 100));
   EXPECT_FALSE(NO::internal::is_island(9.0, 1.0, 50, 100));
+}
+
+TEST(Global_sign, SheetsMostlyUnseenAreLeftToTheWindingNumber)
+{
+  // Four sheets of ten samples of area 1: sheet 0 seen over 6 samples
+  // (60%), sheet 1 over 7, sheet 2 over all, sheet 3 over none.  Each seen
+  // sample votes -1 (faces away).  The rule keeps sheets 0 and 3 from the
+  // sheets' tier; visibility_flips() would turn all but sheet 3.
+  std::vector<double> vote, areas;
+  std::vector<std::uint32_t> group;
+  const int seen[4] = {6, 7, 10, 0};
+  for (std::uint32_t g = 0; g < 4; ++g)
+    for (int j = 0; j < 10; ++j) {
+      vote.push_back(j < seen[g] ? -1.0 : 0.0);
+      areas.push_back(1.0);
+      group.push_back(g);
+    }
+  const std::vector<char> unseen = NO::internal::mostly_unseen(vote, areas, group, 5);
+  EXPECT_EQ(unseen, (std::vector<char>{1, 0, 0, 1, 0})); // (group 4 has no samples)
+  const std::vector<char> flips = NO::visibility_flips(vote, areas, group, std::vector<char>(5, 1));
+  EXPECT_EQ(flips, (std::vector<char>{1, 1, 1, 0, 0}));
+}
+
+TEST(Global_sign, MovesThatTheStageMostlyUndidAreUndoneInFull)
+{
+  // A chain of 40 points.  The solver moved three runs of it: A (5-14),
+  // B (20-29) and C (32-35).  The stage negated 6 points of A, 5 of B and
+  // all of C: only A, more than half undone, is completed.  A kept point
+  // keeps its move as it is, and without a start nothing moves.
+  const std::size_t n = 40;
+  NO::internal::Array_problem problem;
+  problem.number_of_vertices = n;
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    problem.tail.push_back(std::uint32_t(i));
+    problem.head.push_back(std::uint32_t(i + 1));
+    problem.weight.push_back(1.0);
+  }
+  const NO::internal::Incidence inc(problem);
+  std::vector<char> moved(n, 0);
+  auto in = [](std::size_t i, std::size_t a, std::size_t b) { return a <= i && i <= b; };
+  for (std::size_t i = 0; i < n; ++i)
+    moved[i] = char(in(i, 5, 14) || in(i, 20, 29) || in(i, 32, 35));
+  std::vector<NO::Label> before(n, NO::Label(1));
+  for (std::size_t i = 0; i < n; ++i)
+    if (moved[i])
+      before[i] = NO::Label(-1);
+  auto stage = [&]() {
+    std::vector<NO::Label> labels = before;
+    for (std::size_t i = 0; i < n; ++i)
+      if (in(i, 5, 10) || in(i, 20, 24) || in(i, 32, 35))
+        labels[i] = NO::Label(-labels[i]);
+    return labels;
+  };
+  std::vector<NO::Label> labels = stage();
+  EXPECT_EQ(NO::internal::complete_undone_moves(inc, moved, {}, before, labels), 1u);
+  for (std::size_t i = 0; i < n; ++i) {
+    const bool negated = in(i, 5, 14) || in(i, 20, 24) || in(i, 32, 35);
+    EXPECT_EQ(labels[i], negated ? NO::Label(-before[i]) : before[i]) << i;
+  }
+  std::vector<char> keep(n, 0);
+  keep[14] = 1;
+  labels = stage();
+  const std::vector<NO::Label> staged = labels;
+  EXPECT_EQ(NO::internal::complete_undone_moves(inc, moved, keep, before, labels), 0u);
+  EXPECT_EQ(labels, staged);
+  EXPECT_EQ(NO::internal::complete_undone_moves(inc, std::vector<char>(), {}, before, labels), 0u);
+  EXPECT_EQ(labels, staged);
 }
 
 TEST(Global_sign, StreamedIslandsAreNegatedOnUnitsAsInCore)

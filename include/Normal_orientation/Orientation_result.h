@@ -47,6 +47,11 @@ struct Global_sign_summary
   /// manual's *Islands left by the stage*; streamed, segments of patch
   /// units, and 0 where the stage has no units)
   std::size_t islands_flipped = 0;
+  /// the solver's moves (connected points that it negated against the
+  /// labelling it started from) that the stage had negated for the most
+  /// part and then negated in full (the manual's *Moves the stage undid*;
+  /// in core only, 0 streamed)
+  std::size_t moves_completed = 0;
   /// the fraction of the sampled area where w is within the tolerance of
   /// 1/2, after the stage: near 1 on closed surfaces, low on open scans
   double closedness = std::numeric_limits<double>::quiet_NaN();

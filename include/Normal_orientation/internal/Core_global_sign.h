@@ -16,6 +16,7 @@
 #include <Normal_orientation/Winding_number_field.h>
 #include <Normal_orientation/internal/Core_layer_cues.h>
 #include <Normal_orientation/internal/Frustrated_islands.h>
+#include <Normal_orientation/internal/Undone_moves.h>
 #include <Normal_orientation/internal/Graph_reduction.h>
 #include <Normal_orientation/internal/Layer_gap.h>
 #include <Normal_orientation/internal/Parallel.h>
@@ -397,7 +398,10 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
 /// (the patches of the first level), that face away from where they were
 /// seen; the winding number then negates patches, level by level, and its
 /// flips against both the solver and visibility are undone in the sheets
-/// they turn away from where they were seen (`seen_side_vetoes()`).
+/// they turn away from where they were seen (`seen_side_vetoes()`); then
+/// the islands left against their borders (`negate_frustrated_islands()`)
+/// and the rest of the solver's moves that the stage undid for the most
+/// part (`complete_undone_moves()`) are negated.
 /// Components with a point of `has_unary` keep their signs.  With
 /// `cues`, the layer cues of `pairs` (`core_layer_cues()`) after the
 /// stage's signs go to `cues`.  The layer cues' points (`cued`, per point, or empty) keep the signs of their
@@ -527,7 +531,9 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   if (!vetoed.empty())
     search.template negate_samples<ConcurrencyTag>(vetoed);
   report.islands_flipped = negate_frustrated_islands<ConcurrencyTag, Kernel>(inc, samples.index, keep, search, labels);
-  // 5. Components whose top surface faces down are negated.
+  // 5. The solver's moves that the stage undid for the most part are undone in full.
+  report.moves_completed = complete_undone_moves(inc, moved, keep, labels_before, labels);
+  // 6. Components whose top surface faces down are negated.
   for (std::size_t t = 0; t < ns; ++t)
     samples.oriented[t] = labels[samples.index[t]] < 0 ? -normals[samples.index[t]] : normals[samples.index[t]];
   for (std::size_t c = 0; c < nc; ++c)
@@ -539,7 +545,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
       labels[i] = Label(-labels[i]);
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
-  // 6. The layer cues of the final signs.
+  // 7. The layer cues of the final signs.
   if (cues && pairs) {
     for (std::size_t t = 0; t < ns; ++t)
       if (top[samples.component[t]])
@@ -549,8 +555,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   report.visibility = settings.orientation == Global_orientation::VISIBILITY_AND_WINDING;
   report.seen_components_flipped = seen.components_flipped;
   report.seen_patches_flipped = seen.patches_flipped;
-  for (char v : veto)
-    report.seen_vetoes += v ? 1 : 0;
+  report.seen_vetoes = std::size_t(std::count(veto.begin(), veto.end(), char(1)));
   report.points_flipped = 0;
   for (std::size_t i = 0; i < n; ++i)
     report.points_flipped += labels_before[i] != labels[i] ? 1 : 0;

@@ -50,6 +50,30 @@ std::array<double, 3> direction_array(const Vector& v)
   return {{double(v.x()), double(v.y()), double(v.z())}};
 }
 
+/// The share of a sheet's area that the views must see for the sheets' tier
+/// of exterior visibility to decide its sign.  A sheet that reaches into a
+/// pocket that no view sees, and across a wall thinner than the spacing to
+/// a part that they see from behind, may be half seen, half right and half
+/// wrong: its sign is left to the segments' tier and to the winding number.
+constexpr double sheet_seen_share = 2.0 / 3.0;
+
+/// Per group id below `number_of_groups`, whether the samples of `vote`
+/// (0: no view saw it) that `group` puts in it were seen over less than
+/// `sheet_seen_share` of their area (`areas`); a group without area is not.
+inline std::vector<char> mostly_unseen(const std::vector<double>& vote, const std::vector<double>& areas,
+                                       const std::vector<std::uint32_t>& group, std::size_t number_of_groups)
+{
+  std::vector<double> area(number_of_groups, 0.0), seen(number_of_groups, 0.0);
+  for (std::size_t j = 0; j < vote.size(); ++j) {
+    area[group[j]] += areas[j];
+    seen[group[j]] += vote[j] != 0.0 ? areas[j] : 0.0;
+  }
+  std::vector<char> unseen(number_of_groups, 0);
+  for (std::size_t g = 0; g < number_of_groups; ++g)
+    unseen[g] = char(seen[g] < sheet_seen_share * area[g]);
+  return unseen;
+}
+
 /// The decisions of exterior visibility.
 struct Seen_side_flips
 {
@@ -67,7 +91,8 @@ struct Seen_side_flips
 /// `whole_fixed` left out) that face away from the side they were seen from
 /// (`exterior_visibility()` of the samples, with their oriented normals),
 /// then the patches of `sample_patch` that still do (those of the
-/// components of `fixed` left out); nothing unless `settings` asks for
+/// components of `fixed` left out, and those that the views see in less
+/// than `sheet_seen_share` of their area); nothing unless `settings` asks for
 /// visibility.  The samples of `two_layers` (per sample, or empty) do not
 /// vote (their votes are 0): both layers lie within a splat's depth of each
 /// other, so either may be the first that a view meets; the patches where
@@ -115,6 +140,10 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
       if (layered[P] > 0.5 * total[P])
         free_patch[P] = 0;
   }
+  const std::vector<char> unseen = mostly_unseen(vote, areas, sample_patch, number_of_patches);
+  for (std::size_t P = 0; P < number_of_patches; ++P)
+    if (unseen[P])
+      free_patch[P] = 0;
   out.patch = visibility_flips(vote, areas, sample_patch, free_patch);
   for (char f : out.component)
     out.components_flipped += f ? 1 : 0;
