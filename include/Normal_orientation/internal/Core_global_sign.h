@@ -16,11 +16,11 @@
 #include <Normal_orientation/Winding_number_field.h>
 #include <Normal_orientation/internal/Core_layer_cues.h>
 #include <Normal_orientation/internal/Frustrated_islands.h>
-#include <Normal_orientation/internal/Undone_moves.h>
 #include <Normal_orientation/internal/Graph_reduction.h>
 #include <Normal_orientation/internal/Layer_gap.h>
 #include <Normal_orientation/internal/Parallel.h>
 #include <Normal_orientation/internal/Seen_side_rules.h>
+#include <Normal_orientation/internal/Undone_moves.h>
 
 #include <algorithm>
 #include <array>
@@ -393,6 +393,22 @@ void core_winding_levels(const Neighbor_graph& graph, const std::vector<typename
   }
 }
 
+/// Adds to `report` what exterior visibility did (`seen`, its vetoes
+/// `veto`), the points whose labels differ between `before` and `labels`,
+/// and the samples whose width is capped (`width_caps`).
+inline void add_stage_figures(Global_sign_summary& report, const Seen_side_flips& seen, const std::vector<char>& veto,
+                              const std::vector<Label>& before, const std::vector<Label>& labels,
+                              const std::vector<double>& width_caps)
+{
+  report.seen_components_flipped = seen.components_flipped;
+  report.seen_patches_flipped = seen.patches_flipped;
+  report.seen_vetoes = std::size_t(std::count(veto.begin(), veto.end(), char(1)));
+  report.points_flipped = 0;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    report.points_flipped += before[i] != labels[i] ? 1 : 0;
+  report.sharp_samples = sharp_samples(width_caps);
+}
+
 /// The global stage on the in-core arrays (points in Morton order), on a
 /// subsample: exterior visibility negates the components, then the sheets
 /// (the patches of the first level), that face away from where they were
@@ -553,13 +569,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
     *cues = core_layer_cues<ConcurrencyTag, Kernel>(*pairs, points, normals, labels, samples);
   }
   report.visibility = settings.orientation == Global_orientation::VISIBILITY_AND_WINDING;
-  report.seen_components_flipped = seen.components_flipped;
-  report.seen_patches_flipped = seen.patches_flipped;
-  report.seen_vetoes = std::size_t(std::count(veto.begin(), veto.end(), char(1)));
-  report.points_flipped = 0;
-  for (std::size_t i = 0; i < n; ++i)
-    report.points_flipped += labels_before[i] != labels[i] ? 1 : 0;
-  report.sharp_samples = sharp_samples(samples.width_caps);
+  add_stage_figures(report, seen, veto, labels_before, labels, samples.width_caps);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return report;
 }
