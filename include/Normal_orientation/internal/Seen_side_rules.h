@@ -95,8 +95,9 @@ struct Seen_side_flips
 /// than `sheet_seen_share` of their area); nothing unless `settings` asks for
 /// visibility.  The samples of `two_layers` (per sample, or empty) do not
 /// vote (their votes are 0): both layers lie within a splat's depth of each
-/// other, so either may be the first that a view meets; the patches where
-/// they hold most of the area keep their signs.
+/// other, so either may be the first that a view meets; they count as
+/// unseen, so the patches where they hold more than a third of the area
+/// keep their signs.
 template <typename ConcurrencyTag, typename Point, typename Vector>
 Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vector<Vector>& oriented,
                                 const std::vector<double>& areas, const std::vector<std::uint32_t>& sample_component,
@@ -130,16 +131,7 @@ Seen_side_flips seen_side_flips(const std::vector<Point>& points, const std::vec
     if (out.component[sample_component[j]])
       vote[j] = -vote[j];
   }
-  if (!two_layers.empty()) { // (a patch mostly on two layers keeps its sign)
-    std::vector<double> layered(number_of_patches, 0.0), total(number_of_patches, 0.0);
-    for (std::size_t j = 0; j < vote.size(); ++j) {
-      total[sample_patch[j]] += areas[j];
-      layered[sample_patch[j]] += two_layers[j] ? areas[j] : 0.0;
-    }
-    for (std::size_t P = 0; P < number_of_patches; ++P)
-      if (layered[P] > 0.5 * total[P])
-        free_patch[P] = 0;
-  }
+  // (a patch mostly unseen, or mostly on two layers, whose votes are 0, keeps its sign)
   const std::vector<char> unseen = mostly_unseen(vote, areas, sample_patch, number_of_patches);
   for (std::size_t P = 0; P < number_of_patches; ++P)
     if (unseen[P])
