@@ -11,11 +11,13 @@
 // .ply, by extension) through a temporary file and a rename, so an output
 // file is either complete or absent.
 //
-// The program is in four parts: cli/Cli_options.h (the command line),
+// The program is in five parts: cli/Cli_options.h (the command line),
+// cli/Allocator_settings.h (freed memory kept for reuse),
 // cli/Progress_bar.h, cli/Json_writer.h and cli/Cli_report.h (the summary
 // and the JSON report), and this file: the choice of the policies, written
 // once for both drivers, the in-core run and the streamed run.
 
+#include "cli/Allocator_settings.h"
 #include "cli/Cli_options.h"
 #include "cli/Cli_report.h"
 #include "cli/Cli_sign_policy.h"
@@ -346,6 +348,10 @@ int main_impl(int argc, char** argv)
 {
   const auto t0 = Clock::now();
   const Cli::Options o = Cli::parse_options(argc, argv, NORMAL_ORIENTATION_SAMPLE_CLOUD);
+  // In core, freed memory is kept for reuse unless --return-memory; the
+  // streamed run reuses its own buffers (doc/cli.md, "Memory and speed")
+  if (!o.stream && !o.return_memory)
+    Cli::keep_freed_memory();
 #ifdef CGAL_LINKED_WITH_TBB
   // --threads N: at most N threads in every parallel stage of the process,
   // normal estimation included (the library's own stages also run in an

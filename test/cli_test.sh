@@ -77,6 +77,9 @@ for solver in mst qpbo-i lsa-tr; do
   check "stream, $solver: same bytes with 1 and 2 threads" \
     cmp -s "$dir/det_stream_${solver}_1.ply" "$dir/det_stream_${solver}_2.ply"
 done
+# --return-memory changes how the allocator reuses memory, not the result
+expect_exit 0 "qpbo-i with --return-memory" "$prog" --quiet --return-memory "$dir/det.xyz" "$dir/det_returned.xyz"
+check "--return-memory: the same bytes" cmp -s "$dir/det_qpbo-i_0.xyz" "$dir/det_returned.xyz"
 expect_exit 0 "stream to xyz, 1 thread" "$prog" --quiet --stream --threads 1 "$dir/det.xyz" "$dir/det_stream_1.xyz"
 expect_exit 0 "stream to xyz, 2 threads" "$prog" --quiet --stream --threads 2 "$dir/det.xyz" "$dir/det_stream_2.xyz"
 check "stream to xyz: same bytes with 1 and 2 threads" cmp -s "$dir/det_stream_1.xyz" "$dir/det_stream_2.xyz"

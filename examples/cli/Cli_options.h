@@ -54,6 +54,7 @@ struct Options
   bool json = false;                   ///< --json
   bool quiet = false;                  ///< --quiet
   bool ascii = false;                  ///< --ascii
+  bool return_memory = false;          ///< --return-memory
   bool stream = false;                 ///< --stream
   std::string presorted;               ///< --presorted: "", "x", "y" or "z"
   std::string components_dir;          ///< --components-dir: one file per component there
@@ -106,6 +107,10 @@ inline const char* usage_text()
          "  --normal-k N         neighbours of the normal estimator (default 18)\n"
          "  --threads N          at most N threads (default, or 0: all cores); the output\n"
          "                       does not depend on N (the same bytes)\n"
+         "  --return-memory      in core: give freed memory back to the system at once\n"
+         "                       (the C library's default): a lower peak, slower where\n"
+         "                       page faults are costly, as on many virtual machines; by\n"
+         "                       default the program keeps it for reuse (glibc only)\n"
          "  --seed S             random seed of randomised solvers (default 0)\n"
          "  --stream             out of core, for clouds larger than memory: sort along the\n"
          "                       principal axis (temporary files in TMPDIR), sweep, segment,\n"
@@ -248,6 +253,8 @@ bool read_option(Options& o, const std::string& a, const Value& value)
     o.quiet = true;
   } else if (a == "--ascii") {
     o.ascii = true;
+  } else if (a == "--return-memory") {
+    o.return_memory = true;
   } else if (a == "--stream") {
     o.stream = true;
   } else if (a == "--presorted") {
