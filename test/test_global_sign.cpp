@@ -11,6 +11,7 @@
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/internal/Frustrated_islands.h>
 #include <Normal_orientation/internal/Layer_edges.h>
+#include <Normal_orientation/internal/Seen_side_rules.h>
 #include <Normal_orientation/internal/Two_layer_fit.h>
 #include <Normal_orientation/internal/Undone_moves.h>
 #include <Normal_orientation/orient_normals.h>
@@ -822,6 +823,52 @@ TEST(Exterior_visibility, TopViewFacingAndDownwardTopFlips)
   EXPECT_THROW(NO::downward_top_flips(facing, areas, std::vector<std::uint32_t>(s.size(), 3), {1}),
                std::invalid_argument);
   EXPECT_THROW(NO::downward_top_flips(facing, std::vector<double>(2), one, {1}), std::invalid_argument);
+}
+
+TEST(Global_sign, LayerCuesFixTheTopRuleOnlyWhereTheComponentReadsClosed)
+{
+  // Two components: a sphere (closed, outward normals) and, far from it, a
+  // flat disc (open, normals up).
+  std::mt19937_64 rng(47);
+  std::vector<Point> points;
+  std::vector<Vector> normals;
+  std::vector<std::uint32_t> component;
+  for (const Sample& t : NO::test::sphere(4000, rng)) {
+    points.push_back(t.p);
+    normals.push_back(t.n);
+    component.push_back(0);
+  }
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  while (component.size() < 6000) {
+    const double x = u(rng), y = u(rng);
+    if (x * x + y * y <= 1.0) {
+      points.push_back(Point(10.0 + x, y, 0.0));
+      normals.push_back(Vector(0, 0, 1));
+      component.push_back(1);
+    }
+  }
+  const std::vector<double> areas = NO::estimate_point_areas<CGAL::Sequential_tag>(points, normals);
+  NO::Winding_patch_signs<Kernel> search;
+  search.build(points, normals, areas);
+  const std::vector<double>& w = search.values();
+  EXPECT_EQ(NO::internal::groups_read_closed(w, areas, component, 2, NO::Global_sign_options()),
+            (std::vector<char>{1, 0}));
+  // The user's unary terms fix a component whatever it reads; the cues fix
+  // only the closed one.
+  EXPECT_EQ(NO::internal::top_rule_fixed({0, 0}, {1, 1}, w, areas, component, 2), (std::vector<char>{1, 0}));
+  EXPECT_EQ(NO::internal::top_rule_fixed({0, 1}, {1, 0}, w, areas, component, 2), (std::vector<char>{1, 1}));
+  EXPECT_EQ(NO::internal::top_rule_fixed({1, 0}, {}, w, areas, component, 2), (std::vector<char>{1, 0}));
+  EXPECT_EQ(NO::internal::top_rule_fixed({}, {0, 1}, w, areas, component, 2), (std::vector<char>{0, 0}));
+  // Inverted, the sphere does not read closed (w near -1/2 on its surface):
+  // the top rule may turn it.
+  std::vector<Vector> inverted(normals);
+  for (std::size_t j = 0; j < inverted.size(); ++j)
+    if (component[j] == 0)
+      inverted[j] = -inverted[j];
+  NO::Winding_patch_signs<Kernel> flipped;
+  flipped.build(points, inverted, areas);
+  EXPECT_EQ(NO::internal::top_rule_fixed({0, 0}, {1, 1}, flipped.values(), areas, component, 2),
+            (std::vector<char>{0, 0}));
 }
 
 TEST(Global_sign, TopSurfacesOfScenesFaceUp)

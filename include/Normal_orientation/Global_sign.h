@@ -248,6 +248,25 @@ void negate_patches(Field& field, const std::vector<std::uint32_t>& batch,
   field.negate(points);
 }
 
+/// Per group id below `number_of_groups`, whether it reads closed: the
+/// samples (w at them, `w`, their `areas` and group ids `group`) with
+/// |w - 1/2| <= `options.agreement_tolerance` hold at least
+/// `options.closed_fraction` of its area.  A group without area does not.
+inline std::vector<char> groups_read_closed(const std::vector<double>& w, const std::vector<double>& areas,
+                                            const std::vector<std::uint32_t>& group, std::size_t number_of_groups,
+                                            const Global_sign_options& options)
+{
+  std::vector<double> agree(number_of_groups, 0.0), area(number_of_groups, 0.0);
+  for (std::size_t j = 0; j < w.size(); ++j) {
+    area[group[j]] += areas[j];
+    agree[group[j]] += std::abs(w[j] - 0.5) <= options.agreement_tolerance ? areas[j] : 0.0;
+  }
+  std::vector<char> closed(number_of_groups, 0);
+  for (std::size_t g = 0; g < number_of_groups; ++g)
+    closed[g] = char(area[g] > 0.0 && agree[g] >= options.closed_fraction * area[g]);
+  return closed;
+}
+
 } // namespace internal
 /// \endcond
 
@@ -418,23 +437,21 @@ void Winding_patch_signs<Kernel>::keep_closed(const std::vector<std::uint32_t>& 
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
   auto slot = [&](std::uint32_t c) { return std::size_t(std::lower_bound(ids.begin(), ids.end(), c) - ids.begin()); };
-  std::vector<double> agree(ids.size(), 0.0), area(ids.size(), 0.0);
+  std::vector<std::uint32_t> group(n);
+  std::vector<char> has_area(ids.size(), 0);
   double total_agree = 0.0, total_area = 0.0;
   for (std::size_t j = 0; j < n; ++j) {
-    const double a = m_areas[j], ok = std::abs(m_w[j] - 0.5) <= options.agreement_tolerance ? a : 0.0;
-    area[slot(component[patch[j]])] += a;
-    agree[slot(component[patch[j]])] += ok;
+    const double a = m_areas[j];
+    group[j] = std::uint32_t(slot(component[patch[j]]));
+    has_area[group[j]] = char(has_area[group[j]] || a > 0.0);
     total_area += a;
-    total_agree += ok;
+    total_agree += std::abs(m_w[j] - 0.5) <= options.agreement_tolerance ? a : 0.0;
   }
   report.closedness = total_area > 0.0 ? total_agree / total_area : 0.0;
-  std::vector<char> closed(ids.size(), 0);
-  for (std::size_t c = 0; c < ids.size(); ++c) {
-    if (area[c] <= 0.0)
-      continue;
-    closed[c] = agree[c] >= options.closed_fraction * area[c];
-    ++(closed[c] ? report.closed_components : report.open_components);
-  }
+  const std::vector<char> closed = internal::groups_read_closed(m_w, m_areas, group, ids.size(), options);
+  for (std::size_t c = 0; c < ids.size(); ++c)
+    if (has_area[c])
+      ++(closed[c] ? report.closed_components : report.open_components);
   std::vector<std::uint32_t> undo;
   for (std::uint32_t P = 0; P < np; ++P)
     if (flip[P] && !closed[slot(component[P])])

@@ -7,7 +7,8 @@
 /// The rules of the global stage that both drivers share around exterior
 /// visibility: its settings, the components, sheets and segments that face
 /// away from the side they were seen from, the vetoes on the winding
-/// number's flips, and the components whose top surface faces down.
+/// number's flips, and the components whose top surface faces down (and
+/// which of them that rule leaves as they are).
 
 #include <Normal_orientation/Exterior_visibility.h>
 #include <Normal_orientation/Global_sign.h>
@@ -203,6 +204,34 @@ std::vector<char> top_side_flips(const std::vector<Point>& points, const std::ve
     eligible[c] = !fixed[c];
   return downward_top_flips(top_view_facing<ConcurrencyTag>(points, oriented, areas, settings.visibility()), areas,
                             sample_component, eligible);
+}
+
+/// Per component id below `number_of_components`, whether the top rule
+/// (`top_side_flips()`) must leave it as it is: the user's unary terms fix
+/// its sign (`fixed_by_user`, per component, or empty), or the layer cues
+/// do (`fixed_by_cues`, or empty) and it reads closed
+/// (`groups_read_closed()` of w at the samples, `w`, with their `areas` and
+/// `sample_component`).  A cue asks the far field whether the gap between
+/// two layers is inside or outside a surface, which only a closed surface
+/// answers: on an open scene (roofs and canopy above the ground, closer to
+/// it than the neighbour distance in a sparse airborne tile), both signs of
+/// the ground are as consistent with the field, and what the scene was seen
+/// from decides.
+inline std::vector<char> top_rule_fixed(const std::vector<char>& fixed_by_user, const std::vector<char>& fixed_by_cues,
+                                        const std::vector<double>& w, const std::vector<double>& areas,
+                                        const std::vector<std::uint32_t>& sample_component,
+                                        std::size_t number_of_components)
+{
+  std::vector<char> fixed(number_of_components, 0);
+  for (std::size_t c = 0; c < fixed_by_user.size() && c < number_of_components; ++c)
+    fixed[c] = fixed_by_user[c];
+  if (std::none_of(fixed_by_cues.begin(), fixed_by_cues.end(), [](char f) { return f != 0; }))
+    return fixed;
+  const std::vector<char> closed =
+    groups_read_closed(w, areas, sample_component, number_of_components, Global_sign_options());
+  for (std::size_t c = 0; c < fixed_by_cues.size() && c < number_of_components; ++c)
+    fixed[c] = char(fixed[c] || (fixed_by_cues[c] && closed[c]));
+  return fixed;
 }
 
 /// Whether the winding number negated a sample against both the solver and

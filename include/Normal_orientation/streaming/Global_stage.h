@@ -369,7 +369,9 @@ void stream_winding_levels(const Global_samples<Kernel>& samples, Winding_patch_
 /// `component` and `segment_has_unary` are per sweep segment.  With
 /// `cues`, the layer cues of the final signs go there
 /// (`stream_layer_cues()`), each as strong as `cue_strength` per point that
-/// its sample stands for.  The field's smoothing widths are capped at the
+/// its sample stands for.  With `fixed_by_cues` (the layer cues' round), the
+/// components that `segment_has_unary` fixes are the cues' (`top_rule_fixed()`).
+/// The field's smoothing widths are capped at the
 /// samples' layer gaps (`contact_width_caps()`, with `layer_gap_points` of
 /// the `n` points having one).  Memory: the subsample, the units and
 /// O(segments).
@@ -380,7 +382,8 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
                                  std::uint64_t layer_gap_points,
                                  const Normal_orientation::internal::Global_settings& settings,
                                  const Progress_reporter& progress, const Unit_inputs& unit_inputs = Unit_inputs(),
-                                 Stream_layer_cues* cues = nullptr, double cue_strength = 0.0)
+                                 Stream_layer_cues* cues = nullptr, double cue_strength = 0.0,
+                                 bool fixed_by_cues = false)
 {
   typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
   const auto t0 = std::chrono::steady_clock::now();
@@ -474,8 +477,12 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   // Components whose top surface faces down are negated.
   for (std::size_t j = 0; j < ns; ++j)
     oriented[j] = seen.seen.component[samples.component[j]] != sample_flip[j] ? -samples.normals[j] : samples.normals[j];
+  const std::vector<char> none;
+  const std::vector<char> top_fixed = Normal_orientation::internal::top_rule_fixed(
+    fixed_by_cues ? none : component_fixed, fixed_by_cues ? component_fixed : none, search.values(), areas,
+    samples.component, nc);
   const std::vector<char> top = Normal_orientation::internal::top_side_flips<ConcurrencyTag>(
-    samples.points, oriented, areas, samples.component, nc, component_fixed, settings);
+    samples.points, oriented, areas, samples.component, nc, top_fixed, settings);
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
   if (cues) {

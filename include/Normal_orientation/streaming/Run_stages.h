@@ -348,7 +348,8 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
                                                    radius, n, swept.layer_gap_points, g, stage(Stage::GLOBAL),
                                                    Unit_inputs{edges.get(), result.edge_span,
                                                                settings.temporary_directory},
-                                                   want_cues && dense && !cue_round ? &cues : nullptr, double(k));
+                                                   want_cues && dense && !cue_round ? &cues : nullptr, double(k),
+                                                   cue_round);
       result.seconds.global += seconds_since(t);
     }
   };
