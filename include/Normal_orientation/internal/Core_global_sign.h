@@ -409,6 +409,113 @@ inline void add_stage_figures(Global_sign_summary& report, const Seen_side_flips
   report.sharp_samples = sharp_samples(width_caps);
 }
 
+/// What exterior visibility decided in the in-core global stage.
+struct Core_seen_sides
+{
+  Seen_side_flips seen;                    ///< components and sheets (and the segments' count)
+  std::vector<std::uint32_t> sheet;        ///< per point: its sheet
+  std::size_t number_of_sheets = 0;
+  std::vector<std::uint32_t> sample_sheet; ///< per sample: its sheet
+};
+
+/// Step 1 of `core_global_signs()`: exterior visibility negates the
+/// components (those of `component_fixed` and `whole_fixed` left out), then
+/// the sheets (patches of slope at most `sheet_slope`), then the
+/// labelling's segments (`segment_tier_flips()`), that face away from the
+/// side they were seen from, in `labels` and `samples.oriented`.  The
+/// points of `cued` (per point, or empty) keep the signs of their sheets
+/// and segments; the samples on the layers of `pairs` do not vote.
+template <typename ConcurrencyTag, typename Kernel>
+Core_seen_sides core_seen_sides(const Neighbor_graph& graph, const Incidence& inc,
+                                const std::vector<typename Kernel::Point_3>& points,
+                                const std::vector<typename Kernel::Vector_3>& normals,
+                                const std::vector<float>& slopes, const std::vector<char>& moved,
+                                const std::vector<std::uint32_t>& component, const std::vector<char>& cued,
+                                const std::vector<char>& component_fixed, const std::vector<char>& whole_fixed,
+                                std::size_t nc,
+                                const Global_settings& settings, const Layer_pairs* pairs,
+                                Core_samples<Kernel>& samples, std::vector<Label>& labels)
+{
+  Core_seen_sides out;
+  const std::size_t n = points.size(), ns = samples.index.size();
+  out.sheet = build_patches<Kernel, ConcurrencyTag>(graph, points, normals, labels, moved, 0.0, slopes, sheet_slope,
+                                                    samples.is_sample, out.number_of_sheets);
+  out.sample_sheet.resize(ns);
+  for (std::size_t t = 0; t < ns; ++t)
+    out.sample_sheet[t] = out.sheet[samples.index[t]];
+  std::vector<char> sample_two_layers; // (per sample)
+  if (pairs && pairs->size() > 0) {
+    sample_two_layers.resize(ns);
+    for (std::size_t t = 0; t < ns; ++t)
+      sample_two_layers[t] = char(std::binary_search(pairs->point.begin(), pairs->point.end(), samples.index[t]));
+  }
+  Seen_side_flips& seen = out.seen;
+  seen = seen_side_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas, samples.component,
+                                         out.sample_sheet, nc, out.number_of_sheets, component_fixed, settings,
+                                         whole_fixed, sample_two_layers);
+  std::vector<std::uint32_t> segment, sample_segment(ns);
+  std::vector<char> segment_flip;
+  if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING) {
+    const std::size_t number_of_segments = labelling_segments(inc, labels, segment);
+    for (std::size_t t = 0; t < ns; ++t)
+      sample_segment[t] = segment[samples.index[t]];
+    segment_flip = segment_tier_flips(samples.areas, samples.component, out.sample_sheet, sample_segment,
+                                      number_of_segments, seen, component_fixed, settings);
+    for (char f : segment_flip)
+      seen.patches_flipped += f ? 1 : 0;
+  }
+  for (std::size_t i = 0; i < cued.size(); ++i)
+    if (cued[i]) {
+      seen.patch[out.sheet[i]] = 0;
+      if (!segment_flip.empty())
+        segment_flip[segment[i]] = 0;
+    }
+  auto seen_flip = [&](std::uint32_t c, std::uint32_t sheet_id, std::uint32_t segment_id) {
+    return (seen.component[c] != seen.patch[sheet_id]) != (!segment_flip.empty() && segment_flip[segment_id]);
+  };
+  for (std::size_t i = 0; i < n; ++i)
+    if (seen_flip(component[i], out.sheet[i], segment.empty() ? 0 : segment[i]))
+      labels[i] = Label(-labels[i]);
+  for (std::size_t t = 0; t < ns; ++t)
+    if (seen_flip(samples.component[t], out.sample_sheet[t], sample_segment[t]))
+      samples.oriented[t] = -samples.oriented[t];
+  return out;
+}
+
+/// Step 3 of `core_global_signs()`: the winding number's flips against both
+/// the solver and visibility (`seen_side_vetoes()`: the labels went from
+/// `before` to `seen_labels` by visibility, then to `labels`) are undone in
+/// `labels` in the sheets of `sides` that they turn away from where they were
+/// seen.  Returns the vetoes per sheet; `vetoed` gets the samples undone
+/// (indices into `sample_index`, the samples' points).
+inline std::vector<char> core_seen_side_vetoes(const Core_seen_sides& sides,
+                                               const std::vector<std::uint32_t>& sample_index,
+                                               const std::vector<double>& areas, const std::vector<Label>& before,
+                                               const std::vector<Label>& seen_labels, std::vector<Label>& labels,
+                                               std::vector<std::uint32_t>& vetoed)
+{
+  const std::size_t ns = sample_index.size();
+  auto by_visibility = [&](std::size_t i) { return char(seen_labels[i] != before[i]); };
+  auto by_winding = [&](std::size_t i) { return char(labels[i] != seen_labels[i]); };
+  std::vector<char> sample_by_visibility(ns), sample_by_winding(ns);
+  for (std::size_t t = 0; t < ns; ++t) {
+    sample_by_visibility[t] = by_visibility(sample_index[t]);
+    sample_by_winding[t] = by_winding(sample_index[t]);
+  }
+  const std::vector<char> veto = seen_side_vetoes(sides.seen.vote, areas, sides.sample_sheet, sample_by_visibility,
+                                                  sample_by_winding, sides.number_of_sheets);
+  vetoed.clear();
+  for (std::size_t t = 0; t < ns; ++t) {
+    const std::size_t i = sample_index[t];
+    if (veto[sides.sheet[i]] && negated_against_both(by_visibility(i), by_winding(i)))
+      vetoed.push_back(std::uint32_t(t));
+  }
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    if (veto[sides.sheet[i]] && negated_against_both(by_visibility(i), by_winding(i)))
+      labels[i] = seen_labels[i];
+  return veto;
+}
+
 /// The global stage on the in-core arrays (points in Morton order), on a
 /// subsample: exterior visibility negates the components, then the sheets
 /// (the patches of the first level), that face away from where they were
@@ -463,51 +570,13 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
       whole_fixed[component[i]] = 1;
   const std::vector<float> slopes = edge_slopes<Kernel, ConcurrencyTag>(graph, points, normals);
   // 1. Exterior visibility.
-  std::size_t number_of_sheets = 0;
-  const std::vector<std::uint32_t> sheet =
-    build_patches<Kernel, ConcurrencyTag>(graph, points, normals, labels, moved, 0.0, slopes, sheet_slope,
-                                          samples.is_sample, number_of_sheets);
-  std::vector<std::uint32_t> sample_sheet(ns);
-  for (std::size_t t = 0; t < ns; ++t)
-    sample_sheet[t] = sheet[samples.index[t]];
-  std::vector<char> sample_two_layers; // (per sample)
-  if (pairs && pairs->size() > 0) {
-    sample_two_layers.resize(ns);
-    for (std::size_t t = 0; t < ns; ++t)
-      sample_two_layers[t] = char(std::binary_search(pairs->point.begin(), pairs->point.end(), samples.index[t]));
-  }
-  Seen_side_flips seen = seen_side_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
-                                                         samples.component, sample_sheet, nc, number_of_sheets,
-                                                         component_fixed, settings, whole_fixed, sample_two_layers);
-  std::vector<std::uint32_t> segment, sample_segment(ns);
-  std::size_t number_of_segments = 0;
-  std::vector<char> segment_flip;
   const Incidence inc(graph, get(&Neighbor_edge::weight, graph), "the global stage"); // (segments, islands)
-  if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING)
-    number_of_segments = labelling_segments(inc, labels, segment);
-  if (settings.orientation == Global_orientation::VISIBILITY_AND_WINDING) {
-    for (std::size_t t = 0; t < ns; ++t)
-      sample_segment[t] = segment[samples.index[t]];
-    segment_flip = segment_tier_flips(samples.areas, samples.component, sample_sheet, sample_segment,
-                                      number_of_segments, seen, component_fixed, settings);
-    for (char f : segment_flip)
-      seen.patches_flipped += f ? 1 : 0;
-  }
-  for (std::size_t i = 0; i < cued.size(); ++i)
-    if (cued[i]) {
-      seen.patch[sheet[i]] = 0;
-      if (!segment_flip.empty())
-        segment_flip[segment[i]] = 0;
-    }
-  auto seen_flip = [&](std::uint32_t c, std::uint32_t sheet_id, std::uint32_t segment_id) {
-    return (seen.component[c] != seen.patch[sheet_id]) != (!segment_flip.empty() && segment_flip[segment_id]);
-  };
-  for (std::size_t i = 0; i < n; ++i)
-    if (seen_flip(component[i], sheet[i], segment.empty() ? 0 : segment[i]))
-      labels[i] = Label(-labels[i]);
-  for (std::size_t t = 0; t < ns; ++t)
-    if (seen_flip(samples.component[t], sample_sheet[t], sample_segment[t]))
-      samples.oriented[t] = -samples.oriented[t];
+  const Core_seen_sides seen_sides = core_seen_sides<ConcurrencyTag, Kernel>(
+    graph, inc, points, normals, slopes, moved, component, cued, component_fixed, whole_fixed, nc, settings, pairs,
+    samples, labels);
+  const Seen_side_flips& seen = seen_sides.seen;
+  const std::vector<std::uint32_t>& sheet = seen_sides.sheet;
+  const std::size_t number_of_sheets = seen_sides.number_of_sheets;
   const std::vector<Label> seen_labels = labels;
   // 2. The winding number.
   Global_sign_summary report;
@@ -525,24 +594,9 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
                                               number_of_sheets, labels, report, search);
   // 3. Its flips against both the solver and visibility, in the sheets they
   // turn away from where they were seen, are undone.
-  auto by_visibility = [&](std::size_t i) { return char(seen_labels[i] != labels_before[i]); };
-  auto by_winding = [&](std::size_t i) { return char(labels[i] != seen_labels[i]); };
-  std::vector<char> sample_by_visibility(ns), sample_by_winding(ns);
-  for (std::size_t t = 0; t < ns; ++t) {
-    sample_by_visibility[t] = by_visibility(samples.index[t]);
-    sample_by_winding[t] = by_winding(samples.index[t]);
-  }
-  const std::vector<char> veto = seen_side_vetoes(seen.vote, samples.areas, sample_sheet, sample_by_visibility,
-                                                  sample_by_winding, number_of_sheets);
   std::vector<std::uint32_t> vetoed; // (samples)
-  for (std::size_t t = 0; t < ns; ++t) {
-    const std::size_t i = samples.index[t];
-    if (veto[sheet[i]] && negated_against_both(by_visibility(i), by_winding(i)))
-      vetoed.push_back(std::uint32_t(t));
-  }
-  for (std::size_t i = 0; i < n; ++i)
-    if (veto[sheet[i]] && negated_against_both(by_visibility(i), by_winding(i)))
-      labels[i] = seen_labels[i];
+  const std::vector<char> veto =
+    core_seen_side_vetoes(seen_sides, samples.index, samples.areas, labels_before, seen_labels, labels, vetoed);
   // 4. Islands left against their surroundings, where the field agrees.
   if (!vetoed.empty())
     search.template negate_samples<ConcurrencyTag>(vetoed);
