@@ -825,7 +825,7 @@ TEST(Exterior_visibility, TopViewFacingAndDownwardTopFlips)
   EXPECT_THROW(NO::downward_top_flips(facing, std::vector<double>(2), one, {1}), std::invalid_argument);
 }
 
-TEST(Global_sign, LayerCuesFixTheTopRuleOnlyWhereTheComponentReadsClosed)
+TEST(Global_sign, ClosedSurfacesReadClosedAndSheetsOpen)
 {
   // Two components: a sphere (closed, outward normals) and, far from it, a
   // flat disc (open, normals up).
@@ -850,25 +850,78 @@ TEST(Global_sign, LayerCuesFixTheTopRuleOnlyWhereTheComponentReadsClosed)
   const std::vector<double> areas = NO::estimate_point_areas<CGAL::Sequential_tag>(points, normals);
   NO::Winding_patch_signs<Kernel> search;
   search.build(points, normals, areas);
-  const std::vector<double>& w = search.values();
-  EXPECT_EQ(NO::internal::groups_read_closed(w, areas, component, 2, NO::Global_sign_options()),
+  EXPECT_EQ(NO::internal::groups_read_closed(search.values(), areas, component, 2, NO::Global_sign_options()),
             (std::vector<char>{1, 0}));
-  // The user's unary terms fix a component whatever it reads; the cues fix
-  // only the closed one.
-  EXPECT_EQ(NO::internal::top_rule_fixed({0, 0}, {1, 1}, w, areas, component, 2), (std::vector<char>{1, 0}));
-  EXPECT_EQ(NO::internal::top_rule_fixed({0, 1}, {1, 0}, w, areas, component, 2), (std::vector<char>{1, 1}));
-  EXPECT_EQ(NO::internal::top_rule_fixed({1, 0}, {}, w, areas, component, 2), (std::vector<char>{1, 0}));
-  EXPECT_EQ(NO::internal::top_rule_fixed({}, {0, 1}, w, areas, component, 2), (std::vector<char>{0, 0}));
-  // Inverted, the sphere does not read closed (w near -1/2 on its surface):
-  // the top rule may turn it.
+  // Inverted, the sphere does not read closed (w near -1/2 on its surface).
   std::vector<Vector> inverted(normals);
   for (std::size_t j = 0; j < inverted.size(); ++j)
     if (component[j] == 0)
       inverted[j] = -inverted[j];
   NO::Winding_patch_signs<Kernel> flipped;
   flipped.build(points, inverted, areas);
-  EXPECT_EQ(NO::internal::top_rule_fixed({0, 0}, {1, 1}, flipped.values(), areas, component, 2),
+  EXPECT_EQ(NO::internal::groups_read_closed(flipped.values(), areas, component, 2, NO::Global_sign_options()),
             (std::vector<char>{0, 0}));
+}
+
+TEST(Global_sign, TopRuleReadsTheSamplesWhoseNormalsAgree)
+{
+  // Component 0: a square of ground, normals down (inverted), under a slab
+  // of scatter over three quarters of it (a canopy: random normals, most of
+  // them up).  Component 1: the same with the ground's normals up.
+  // Component 2, far away: the scatter alone, normals mostly down.
+  std::mt19937_64 rng(53);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Point> points;
+  std::vector<Vector> normals;
+  std::vector<std::uint32_t> component;
+  auto scatter_normal = [&](double bias) {
+    const double x = u(rng), y = u(rng), z = u(rng);
+    return Vector(x, y, z + bias);
+  };
+  for (std::uint32_t c = 0; c < 2; ++c) {
+    const double x0 = 10.0 * c;
+    for (int i = 0; i < 2000; ++i) {
+      const double x = u(rng), y = u(rng);
+      points.push_back(Point(x0 + x, y, 0.0));
+      normals.push_back(Vector(0, 0, c == 0 ? -1.0 : 1.0));
+      component.push_back(c);
+    }
+    for (int i = 0; i < 3000; ++i) {
+      const double x = u(rng), y = u(rng), z = u(rng);
+      points.push_back(Point(x0 - 0.25 + 0.75 * x, y, 0.3 + 0.1 * z));
+      normals.push_back(scatter_normal(1.5));
+      component.push_back(c);
+    }
+  }
+  for (int i = 0; i < 3000; ++i) {
+    const double x = u(rng), y = u(rng), z = u(rng);
+    points.push_back(Point(19.75 + 0.75 * x, y, 0.3 + 0.1 * z));
+    normals.push_back(scatter_normal(-1.5));
+    component.push_back(2);
+  }
+  const std::vector<char> agree = NO::internal::normals_agree<CGAL::Sequential_tag>(points, normals);
+  std::size_t ground_agree = 0, scatter_agree = 0;
+  for (std::size_t j = 0; j < points.size(); ++j)
+    (points[j].z() == 0.0 ? ground_agree : scatter_agree) += agree[j] ? 1 : 0;
+  EXPECT_GE(ground_agree, 3800u);  // of 4000 (a few have scatter among their neighbours)
+  EXPECT_LE(scatter_agree, 450u);  // of 9000
+  EXPECT_EQ(agree, NO::internal::normals_agree<CGAL::Parallel_tag>(points, normals));
+  const std::vector<double> areas = NO::estimate_point_areas<CGAL::Sequential_tag>(points, normals);
+  // All samples counted, the scatter's top outvotes the ground it hides.
+  const std::vector<double> facing = NO::top_view_facing<CGAL::Sequential_tag>(points, normals, areas);
+  EXPECT_EQ(NO::downward_top_flips(facing, areas, component, {1, 1, 1}), (std::vector<char>{0, 0, 1}));
+  // The rule reads the samples that agree (the ground) where they hold a tenth
+  // of the area; the scatter alone, all of its samples.
+  NO::internal::Global_settings settings;
+  settings.orientation = NO::Global_orientation::VISIBILITY_AND_WINDING;
+  EXPECT_EQ(NO::internal::top_side_flips<CGAL::Sequential_tag>(points, normals, areas, component, 3, {}, settings),
+            (std::vector<char>{1, 0, 1}));
+  EXPECT_EQ(NO::internal::top_side_flips<CGAL::Sequential_tag>(points, normals, areas, component, 3, {1, 0, 0},
+                                                               settings),
+            (std::vector<char>{0, 0, 1}));
+  settings.orientation = NO::Global_orientation::WINDING;
+  EXPECT_EQ(NO::internal::top_side_flips<CGAL::Sequential_tag>(points, normals, areas, component, 3, {}, settings),
+            (std::vector<char>{0, 0, 0}));
 }
 
 TEST(Global_sign, TopSurfacesOfScenesFaceUp)

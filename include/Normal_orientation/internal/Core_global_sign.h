@@ -606,10 +606,11 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   // 6. Components whose top surface faces down are negated.
   for (std::size_t t = 0; t < ns; ++t)
     samples.oriented[t] = labels[samples.index[t]] < 0 ? -normals[samples.index[t]] : normals[samples.index[t]];
-  const std::vector<char> top_fixed =
-    top_rule_fixed(component_fixed, whole_fixed, search.values(), samples.areas, samples.component, nc);
+  // (the user's unary terms hold against it; the layer cues' do not: on a
+  // closed surface the top faces up, and on an open scene the cues' far field
+  // does not tell the sides apart)
   const std::vector<char> top = top_side_flips<ConcurrencyTag>(samples.points, samples.oriented, samples.areas,
-                                                               samples.component, nc, top_fixed, settings);
+                                                               samples.component, nc, component_fixed, settings);
   for (std::size_t i = 0; i < n; ++i)
     if (top[component[i]])
       labels[i] = Label(-labels[i]);

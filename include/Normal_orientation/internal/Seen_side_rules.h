@@ -7,11 +7,11 @@
 /// The rules of the global stage that both drivers share around exterior
 /// visibility: its settings, the components, sheets and segments that face
 /// away from the side they were seen from, the vetoes on the winding
-/// number's flips, and the components whose top surface faces down (and
-/// which of them that rule leaves as they are).
+/// number's flips, and the components whose top surface faces down.
 
 #include <Normal_orientation/Exterior_visibility.h>
 #include <Normal_orientation/Global_sign.h>
+#include <Normal_orientation/internal/Normal_agreement.h>
 
 #include <algorithm>
 #include <array>
@@ -184,13 +184,21 @@ inline std::vector<char> segment_tier_flips(const std::vector<double>& areas,
   return flip;
 }
 
+/// The share of a component's area that the samples whose normals agree
+/// with their neighbours' must hold for the top rule to read only them.
+constexpr double top_agreeing_share = 0.1;
+
 /// The components (ids below `number_of_components`, those of `fixed` left
 /// out) whose top surface faces down (`downward_top_flips()` of
 /// `top_view_facing()` of the samples, with their final oriented normals);
 /// nothing unless `settings` asks for visibility.  A closed surface's top
 /// faces up, and so does the ground of a scene seen from above or from the
 /// ground: this undoes the winding number where it takes a scene open to
-/// the sky (a street between facades) for part of a closed surface.
+/// the sky (a street between facades) for part of a closed surface.  Only
+/// the samples whose normals agree with their neighbours' (`normals_agree()`)
+/// count, in every component where they hold at least `top_agreeing_share`
+/// of the area: scatter (a forest's canopy over the ground) hides much of
+/// the ground from above, and its normals do not say which way is up.
 template <typename ConcurrencyTag, typename Point, typename Vector>
 std::vector<char> top_side_flips(const std::vector<Point>& points, const std::vector<Vector>& oriented,
                                  const std::vector<double>& areas, const std::vector<std::uint32_t>& sample_component,
@@ -202,36 +210,20 @@ std::vector<char> top_side_flips(const std::vector<Point>& points, const std::ve
   std::vector<char> eligible(number_of_components, 1);
   for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
     eligible[c] = !fixed[c];
-  return downward_top_flips(top_view_facing<ConcurrencyTag>(points, oriented, areas, settings.visibility()), areas,
+  const std::vector<char> agree = normals_agree<ConcurrencyTag>(points, oriented);
+  std::vector<double> area(number_of_components, 0.0), agreeing(number_of_components, 0.0);
+  for (std::size_t j = 0; j < agree.size(); ++j) {
+    area[sample_component[j]] += areas[j];
+    agreeing[sample_component[j]] += agree[j] ? areas[j] : 0.0;
+  }
+  std::vector<double> counted(areas); // (the areas that count)
+  for (std::size_t j = 0; j < counted.size(); ++j) {
+    const std::uint32_t c = sample_component[j];
+    if (!agree[j] && agreeing[c] >= top_agreeing_share * area[c])
+      counted[j] = 0.0;
+  }
+  return downward_top_flips(top_view_facing<ConcurrencyTag>(points, oriented, areas, settings.visibility()), counted,
                             sample_component, eligible);
-}
-
-/// Per component id below `number_of_components`, whether the top rule
-/// (`top_side_flips()`) must leave it as it is: the user's unary terms fix
-/// its sign (`fixed_by_user`, per component, or empty), or the layer cues
-/// do (`fixed_by_cues`, or empty) and it reads closed
-/// (`groups_read_closed()` of w at the samples, `w`, with their `areas` and
-/// `sample_component`).  A cue asks the far field whether the gap between
-/// two layers is inside or outside a surface, which only a closed surface
-/// answers: on an open scene (roofs and canopy above the ground, closer to
-/// it than the neighbour distance in a sparse airborne tile), both signs of
-/// the ground are as consistent with the field, and what the scene was seen
-/// from decides.
-inline std::vector<char> top_rule_fixed(const std::vector<char>& fixed_by_user, const std::vector<char>& fixed_by_cues,
-                                        const std::vector<double>& w, const std::vector<double>& areas,
-                                        const std::vector<std::uint32_t>& sample_component,
-                                        std::size_t number_of_components)
-{
-  std::vector<char> fixed(number_of_components, 0);
-  for (std::size_t c = 0; c < fixed_by_user.size() && c < number_of_components; ++c)
-    fixed[c] = fixed_by_user[c];
-  if (std::none_of(fixed_by_cues.begin(), fixed_by_cues.end(), [](char f) { return f != 0; }))
-    return fixed;
-  const std::vector<char> closed =
-    groups_read_closed(w, areas, sample_component, number_of_components, Global_sign_options());
-  for (std::size_t c = 0; c < fixed_by_cues.size() && c < number_of_components; ++c)
-    fixed[c] = char(fixed[c] || (fixed_by_cues[c] && closed[c]));
-  return fixed;
 }
 
 /// Whether the winding number negated a sample against both the solver and

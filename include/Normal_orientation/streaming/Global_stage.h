@@ -370,7 +370,8 @@ void stream_winding_levels(const Global_samples<Kernel>& samples, Winding_patch_
 /// `cues`, the layer cues of the final signs go there
 /// (`stream_layer_cues()`), each as strong as `cue_strength` per point that
 /// its sample stands for.  With `fixed_by_cues` (the layer cues' round), the
-/// components that `segment_has_unary` fixes are the cues' (`top_rule_fixed()`).
+/// components that `segment_has_unary` fixes are the cues', which the top
+/// surface's rule (`top_side_flips()`) does not leave out, as in core.
 /// The field's smoothing widths are capped at the
 /// samples' layer gaps (`contact_width_caps()`, with `layer_gap_points` of
 /// the `n` points having one).  Memory: the subsample, the units and
@@ -477,12 +478,10 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
   // Components whose top surface faces down are negated.
   for (std::size_t j = 0; j < ns; ++j)
     oriented[j] = seen.seen.component[samples.component[j]] != sample_flip[j] ? -samples.normals[j] : samples.normals[j];
-  const std::vector<char> none;
-  const std::vector<char> top_fixed = Normal_orientation::internal::top_rule_fixed(
-    fixed_by_cues ? none : component_fixed, fixed_by_cues ? component_fixed : none, search.values(), areas,
-    samples.component, nc);
+  // (the user's unary terms hold against it, the layer cues' do not: as in core)
   const std::vector<char> top = Normal_orientation::internal::top_side_flips<ConcurrencyTag>(
-    samples.points, oriented, areas, samples.component, nc, top_fixed, settings);
+    samples.points, oriented, areas, samples.component, nc, fixed_by_cues ? std::vector<char>() : component_fixed,
+    settings);
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
   if (cues) {
