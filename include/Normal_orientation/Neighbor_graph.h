@@ -27,6 +27,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
 #include <limits>
 #include <stdexcept>
@@ -137,11 +138,6 @@ inline double estimate_neighbor_radius(std::vector<float>& kth_squared_distances
 namespace internal {
 
 
-/// The k nearest neighbours of every point (itself excluded), as flat
-/// arrays: neighbors[i*k + t] and squared distances sq_dist[i*k + t],
-/// t = 0..k-1, sorted by distance.  Computed with CGAL's kd-tree and
-/// `Orthogonal_k_neighbor_search`, queries in parallel, in index order (so
-/// points in a spatially coherent order, see `morton_order()`, query fast).
 /// The CGAL kd-tree over point indices (with the points cache) and its
 /// k-nearest-neighbour search, as used by the graph and the sweep.
 template <typename Kernel>
@@ -202,6 +198,11 @@ struct Knn_tree_types
   }
 };
 
+/// The k nearest neighbours of every point (itself excluded), as flat
+/// arrays: neighbors[i*k + t] and squared distances sq_dist[i*k + t],
+/// t = 0..k-1, sorted by distance.  Computed with CGAL's kd-tree and
+/// `Orthogonal_k_neighbor_search`, queries in parallel, in index order (so
+/// points in a spatially coherent order, see `morton_order()`, query fast).
 template <typename ConcurrencyTag, typename Kernel>
 void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, unsigned int k,
                          std::vector<std::uint32_t>& neighbors, std::vector<float>& sq_dist,
@@ -239,6 +240,28 @@ void k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points, un
     }, 256);
     progress.report(progress_begin + (progress_end - progress_begin) * double(b1) / double(n));
   }
+}
+
+/// `k_nearest_neighbors()` of points in any order, queried in Morton order
+/// (`morton_order()`, several times faster than an incoherent order) without
+/// a progress report.  Returns that order; row s of `neighbors` and
+/// `sq_dist` (k entries each) belongs to points[order[s]], and its
+/// neighbours are indices into `points`.  k must be at most the points - 1.
+template <typename ConcurrencyTag, typename Kernel>
+std::vector<std::uint32_t> morton_k_nearest_neighbors(const std::vector<typename Kernel::Point_3>& points,
+                                                      unsigned int k, std::vector<std::uint32_t>& neighbors,
+                                                      std::vector<float>& sq_dist)
+{
+  const std::vector<std::uint32_t> order = morton_order<ConcurrencyTag>(points);
+  {
+    std::vector<typename Kernel::Point_3> sorted(points.size());
+    for (std::size_t s = 0; s < points.size(); ++s)
+      sorted[s] = points[order[s]];
+    k_nearest_neighbors<ConcurrencyTag, Kernel>(sorted, k, neighbors, sq_dist, Progress_reporter(), 0.0, 1.0);
+  }
+  for (std::uint32_t& j : neighbors)
+    j = order[j];
+  return order;
 }
 
 /// The layer gap of every point (`layer_gap_code()` of the least

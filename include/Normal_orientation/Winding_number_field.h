@@ -142,17 +142,10 @@ std::vector<double> estimate_point_areas(const std::vector<Point>& points, const
   k = unsigned(std::min<std::size_t>(k, n > 0 ? n - 1 : 0));
   if (k == 0)
     return areas;
-  // kNN queries in Morton order (fast: coherent in the kd-tree); sorted[s] = points[order[s]]
-  const std::vector<std::uint32_t> order = internal::morton_order<ConcurrencyTag>(points);
-  std::vector<Point> sorted(n);
-  for (std::size_t s = 0; s < n; ++s)
-    sorted[s] = points[order[s]];
   std::vector<std::uint32_t> nb;
   std::vector<float> d2;
-  internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(sorted, k, nb, d2, Progress_reporter(), 0.0, 1.0);
+  const std::vector<std::uint32_t> order = internal::morton_k_nearest_neighbors<ConcurrencyTag, Kernel>(points, k, nb, d2);
   std::vector<float>().swap(d2);
-  for (std::uint32_t& j : nb)
-    j = order[j];
   const double pi = 3.14159265358979323846;
   internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t sb, std::size_t se) {
     double x[64], y[64];

@@ -113,6 +113,18 @@ inline std::array<std::int64_t, 3> coarse_coordinates(std::uint64_t key)
            std::int64_t((key >> 21) & m) - coarse_coordinate_offset, std::int64_t(key & m) - coarse_coordinate_offset}};
 }
 
+/// Adds (x, y, z)(x, y, z)^T to the packed symmetric matrix `m` (xx xy xz
+/// yy yz zz), the form that `coarse_eigen()` reads.
+inline void add_outer(std::array<double, 6>& m, double x, double y, double z)
+{
+  m[0] += x * x;
+  m[1] += x * y;
+  m[2] += x * z;
+  m[3] += y * y;
+  m[4] += y * z;
+  m[5] += z * z;
+}
+
 /// The eigenvalues of the packed symmetric matrix `a` (xx xy xz yy yz zz),
 /// ascending, and in `axis` the unit eigenvector of `values[which]`.
 inline void coarse_eigen(const std::array<double, 6>& a, double (&values)[3], int which, std::array<double, 3>& axis)
@@ -246,16 +258,6 @@ public:
   Coarse_scale_report& report() { return m_report; }
 
 private:
-  static void add_outer(std::array<double, 6>& m, double x, double y, double z)
-  {
-    m[0] += x * x;
-    m[1] += x * y;
-    m[2] += x * z;
-    m[3] += y * y;
-    m[4] += y * z;
-    m[5] += z * z;
-  }
-
   std::uint64_t key_of(const double (&q)[3]) const
   {
     std::array<std::int64_t, 3> c;

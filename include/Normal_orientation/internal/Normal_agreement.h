@@ -12,15 +12,14 @@
 /// samples instead of a grid cell.
 
 #include <Normal_orientation/Neighbor_graph.h>
-#include <Normal_orientation/Progress.h>
 #include <Normal_orientation/internal/Coarse_scale.h>
 #include <Normal_orientation/internal/Parallel.h>
+#include <Normal_orientation/internal/Unit_vector.h>
 
 #include <CGAL/Kernel_traits.h>
 
 #include <algorithm>
 #include <array>
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -45,55 +44,32 @@ std::vector<char> normals_agree(const std::vector<Point>& points, const std::vec
 {
   typedef typename CGAL::Kernel_traits<Point>::Kernel Kernel;
   const std::size_t n = points.size();
-  auto unit = [&](std::size_t i, double (&u)[3]) {
-    const Vector& v = normals[i];
-    const double x = CGAL::to_double(v.x()), y = CGAL::to_double(v.y()), z = CGAL::to_double(v.z());
-    const double length = std::sqrt(x * x + y * y + z * z);
-    if (!(length > 0.0) || !std::isfinite(length))
-      return false;
-    u[0] = x / length;
-    u[1] = y / length;
-    u[2] = z / length;
-    return true;
-  };
+  std::vector<std::array<double, 3>> unit(n); // (zero: no normal)
   std::vector<char> agree(n, 0);
-  const unsigned int k = unsigned(std::min<std::size_t>(agreement_neighbors, n > 0 ? n - 1 : 0));
-  if (k == 0) {
-    double u[3];
-    for (std::size_t i = 0; i < n; ++i)
-      agree[i] = char(unit(i, u));
-    return agree;
+  for (std::size_t i = 0; i < n; ++i) {
+    unit[i] = unit_vector(CGAL::to_double(normals[i].x()), CGAL::to_double(normals[i].y()),
+                          CGAL::to_double(normals[i].z()));
+    agree[i] = char(unit[i] != std::array<double, 3>{{0.0, 0.0, 0.0}});
   }
-  // kNN in Morton order (coherent queries); sorted[s] = points[order[s]]
-  const std::vector<std::uint32_t> order = morton_order<ConcurrencyTag>(points);
-  std::vector<Point> sorted(n);
-  for (std::size_t s = 0; s < n; ++s)
-    sorted[s] = points[order[s]];
+  const unsigned int k = unsigned(std::min<std::size_t>(agreement_neighbors, n > 0 ? n - 1 : 0));
+  if (k == 0)
+    return agree;
   std::vector<std::uint32_t> nb;
   std::vector<float> d2;
-  k_nearest_neighbors<ConcurrencyTag, Kernel>(sorted, k, nb, d2, Progress_reporter(), 0.0, 1.0);
+  const std::vector<std::uint32_t> order = morton_k_nearest_neighbors<ConcurrencyTag, Kernel>(points, k, nb, d2);
   parallel_chunks<ConcurrencyTag>(n, [&](std::size_t sb, std::size_t se) {
     for (std::size_t s = sb; s < se; ++s) {
       const std::size_t i = order[s];
-      double u[3];
-      if (!unit(i, u))
+      if (!agree[i])
         continue;
-      std::array<double, 6> m{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0}}; // (xx xy xz yy yz zz)
+      std::array<double, 6> m{{0.0, 0.0, 0.0, 0.0, 0.0, 0.0}};
       double count = 0.0;
-      auto add = [&](const double (&a)[3]) {
-        m[0] += a[0] * a[0];
-        m[1] += a[0] * a[1];
-        m[2] += a[0] * a[2];
-        m[3] += a[1] * a[1];
-        m[4] += a[1] * a[2];
-        m[5] += a[2] * a[2];
-        count += 1.0;
-      };
-      add(u);
-      for (unsigned int t = 0; t < k; ++t) {
-        double v[3];
-        if (unit(order[nb[s * k + t]], v))
-          add(v);
+      for (unsigned int t = 0; t <= k; ++t) { // the sample, then its neighbours
+        const std::array<double, 3>& u = unit[t == 0 ? i : nb[s * k + t - 1]];
+        if (u[0] != 0.0 || u[1] != 0.0 || u[2] != 0.0) {
+          add_outer(m, u[0], u[1], u[2]);
+          count += 1.0;
+        }
       }
       for (double& x : m)
         x /= count;

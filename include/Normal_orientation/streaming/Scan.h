@@ -133,24 +133,15 @@ inline double radius_of_neighbors(const std::vector<float>& d2, unsigned int k, 
 /// r for a cloud of `n` points of which `sample` is a uniform sample: the
 /// rule of `estimate_neighbor_radius()` over the sample's k-th neighbour
 /// distances, scaled by sqrt(sample / n) (the spacing of a surface sample).
-/// `sample` is reordered.
 template <typename ConcurrencyTag, typename Kernel>
-double sample_radius(std::vector<typename Kernel::Point_3>& sample, unsigned int k, std::uint64_t n)
+double sample_radius(const std::vector<typename Kernel::Point_3>& sample, unsigned int k, std::uint64_t n)
 {
   const unsigned int ks = unsigned(std::min<std::size_t>(k, sample.size() > 1 ? sample.size() - 1 : 0));
   if (ks == 0)
     return 1.0;
-  { // queries in Morton order are several times faster (the quantile does not depend on the order)
-    const std::vector<std::uint32_t> order = Normal_orientation::internal::morton_order<ConcurrencyTag>(sample);
-    std::vector<typename Kernel::Point_3> sorted(sample.size());
-    for (std::size_t i = 0; i < order.size(); ++i)
-      sorted[i] = sample[order[i]];
-    sample.swap(sorted);
-  }
   std::vector<std::uint32_t> nb;
-  std::vector<float> d2;
-  Normal_orientation::internal::k_nearest_neighbors<ConcurrencyTag, Kernel>(sample, ks, nb, d2, Progress_reporter(),
-                                                                             0, 1);
+  std::vector<float> d2; // (the quantile does not depend on the order of the rows)
+  Normal_orientation::internal::morton_k_nearest_neighbors<ConcurrencyTag, Kernel>(sample, ks, nb, d2);
   return radius_of_neighbors(d2, ks, std::sqrt(double(sample.size()) / double(n)));
 }
 
