@@ -922,6 +922,29 @@ TEST(Global_sign, TopRuleReadsTheSamplesWhoseNormalsAgree)
   settings.orientation = NO::Global_orientation::WINDING;
   EXPECT_EQ(NO::internal::top_side_flips<CGAL::Sequential_tag>(points, normals, areas, component, 3, {}, settings),
             (std::vector<char>{0, 0, 0}));
+  // The test that spares reading agreement: component 1's top faces up
+  // (nothing to flip); a flip under any counting that keeps a tenth of the
+  // area implies it passes.
+  EXPECT_TRUE(NO::internal::top_flip_possible(facing, areas, component, {1, 0, 0}));
+  EXPECT_TRUE(NO::internal::top_flip_possible(facing, areas, component, {0, 0, 1}));
+  EXPECT_FALSE(NO::internal::top_flip_possible(facing, areas, component, {0, 1, 0}));
+  std::bernoulli_distribution keep(0.15);
+  std::size_t flips = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    std::vector<double> counted(areas);
+    for (double& a : counted)
+      a = keep(rng) ? a : 0.0;
+    const std::vector<char> flip = NO::downward_top_flips(facing, counted, component, {1, 1, 1});
+    for (std::uint32_t c = 0; c < 3; ++c) {
+      std::vector<char> only(3, 0);
+      only[c] = 1;
+      flips += flip[c] ? 1 : 0;
+      if (flip[c]) {
+        EXPECT_TRUE(NO::internal::top_flip_possible(facing, areas, component, only)) << "trial " << trial;
+      }
+    }
+  }
+  EXPECT_GE(flips, 40u); // (the implication was tested)
 }
 
 TEST(Global_sign, TopSurfacesOfScenesFaceUp)

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -188,6 +189,32 @@ inline std::vector<char> segment_tier_flips(const std::vector<double>& areas,
 /// with their neighbours' must hold for the top rule to read only them.
 constexpr double top_agreeing_share = 0.1;
 
+/// The share of the area counted that the near-horizontal top must hold
+/// for the top rule to read it (`downward_top_flips()`'s minimum_fraction).
+constexpr double top_minimum_fraction = 0.05;
+
+/// Whether the rule of `top_side_flips()` may negate a component of
+/// `eligible`, whichever samples count: where it does, the downward part
+/// of the top (`downward_top_flips()`) exceeds three quarters of
+/// `top_minimum_fraction` of the area counted, which is at least
+/// `top_agreeing_share` of the component's.  Half that bound is tested,
+/// against rounding; false spares reading the samples' agreement, and the
+/// rule then negates nothing.
+inline bool top_flip_possible(const std::vector<double>& facing, const std::vector<double>& areas,
+                              const std::vector<std::uint32_t>& sample_component, const std::vector<char>& eligible)
+{
+  std::vector<double> area(eligible.size(), 0.0), down(eligible.size(), 0.0);
+  for (std::size_t j = 0; j < facing.size(); ++j) {
+    area[sample_component[j]] += areas[j];
+    if (facing[j] < 0.0 && std::abs(facing[j]) >= 0.8660254037844386)
+      down[sample_component[j]] += areas[j];
+  }
+  for (std::size_t c = 0; c < eligible.size(); ++c)
+    if (eligible[c] && down[c] > 0.5 * 0.75 * top_minimum_fraction * top_agreeing_share * area[c])
+      return true;
+  return false;
+}
+
 /// The components (ids below `number_of_components`, those of `fixed` left
 /// out) whose top surface faces down (`downward_top_flips()` of
 /// `top_view_facing()` of the samples, with their final oriented normals);
@@ -210,6 +237,9 @@ std::vector<char> top_side_flips(const std::vector<Point>& points, const std::ve
   std::vector<char> eligible(number_of_components, 1);
   for (std::size_t c = 0; c < fixed.size() && c < number_of_components; ++c)
     eligible[c] = !fixed[c];
+  const std::vector<double> facing = top_view_facing<ConcurrencyTag>(points, oriented, areas, settings.visibility());
+  if (!top_flip_possible(facing, areas, sample_component, eligible))
+    return std::vector<char>(number_of_components, 0);
   const std::vector<char> agree = normals_agree<ConcurrencyTag>(points, oriented);
   std::vector<double> area(number_of_components, 0.0), agreeing(number_of_components, 0.0);
   for (std::size_t j = 0; j < agree.size(); ++j) {
@@ -222,8 +252,7 @@ std::vector<char> top_side_flips(const std::vector<Point>& points, const std::ve
     if (!agree[j] && agreeing[c] >= top_agreeing_share * area[c])
       counted[j] = 0.0;
   }
-  return downward_top_flips(top_view_facing<ConcurrencyTag>(points, oriented, areas, settings.visibility()), counted,
-                            sample_component, eligible);
+  return downward_top_flips(facing, counted, sample_component, eligible, top_minimum_fraction);
 }
 
 /// Whether the winding number negated a sample against both the solver and
