@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: GPL-3.0-or-later
 // This file is part of Normal_orientation.
 //
-// winding_energy ORIENTED.xyz TRUTH.gt.xyz [--stride S] [--json]
+// winding_energy ORIENTED.xyz TRUTH.gt.xyz [--stride S] [--mesh MESH.off] [--json]
 //
 // Tells whether the global stage's winding energy or its search is wrong on a cloud: the
 // energy E = sum_j a_j (w(p_j) - 1/2)^2 of `decide_patch_signs()` on a subsample (every S-th
@@ -10,7 +10,11 @@
 // energy is the lower one, a better search would find it; where it is the higher one, the
 // energy itself prefers the wrong signs at that sampling. The default S is that of the
 // drivers' dense samples (`global_samples(n, true)`); the subsample is the file's order, not
-// the drivers' spatial order, so the figures are close to, not equal to, the stage's.
+// the drivers' spatial order, so the figures are close to, not equal to, the stage's. With the
+// mesh the cloud was sampled from, it also prints how much of the mesh's area the samples'
+// estimated areas (`estimate_point_areas()`, capped as in the stage) add up to: where they fall
+// short, w at the samples falls short of 1/2 whatever the signs.
+#include "Mesh_sampler.h"
 #include "Xyz_io.h"
 
 #include <Normal_orientation/Global_sign.h>
@@ -22,6 +26,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <cstdlib>
+#include <exception>
 #include <string>
 #include <vector>
 
@@ -34,12 +39,13 @@ using Normal_orientation::benchmark::Xyz_row;
 void print_usage(std::FILE* out)
 {
   std::fprintf(out,
-               "usage: winding_energy ORIENTED.xyz TRUTH.gt.xyz [--stride S] [--json]\n"
+               "usage: winding_energy ORIENTED.xyz TRUTH.gt.xyz [--stride S] [--mesh MESH.off] [--json]\n"
                "  Both files: x y z nx ny nz per line, the same points in the same order (the\n"
                "  truth as make_cloud writes it). On every S-th point (default: the drivers'\n"
                "  dense samples, ceil(n / global_samples(n, true))), prints the winding energy\n"
                "  of the global stage per unit of area with the oriented signs and with the\n"
-               "  true signs, and the samples whose sign is wrong. --json: one JSON line.\n"
+               "  true signs, and the samples whose sign is wrong. --mesh: also the samples'\n"
+               "  estimated areas as a share of the mesh's area. --json: one JSON line.\n"
                "  Exit status: 0 done, 1 unreadable or mismatched files, 2 bad usage.\n");
 }
 
@@ -58,7 +64,13 @@ double energy_per_area(const std::vector<Kernel::Point_3>& points, const std::ve
 int main(int argc, char** argv)
 {
   long long stride = 0;
+  std::string mesh_path;
   auto option = [&](const std::string& arg, int& i) {
+    if(arg == "--mesh" && i + 1 < argc)
+    {
+      mesh_path = argv[++i];
+      return true;
+    }
     if(arg != "--stride" || i + 1 >= argc)
       return false;
     char* end = nullptr;
@@ -103,13 +115,33 @@ int main(int argc, char** argv)
   double total = 0.0;
   for(double a : areas)
     total += a;
+  double area_share = -1.0; // (no mesh)
+  if(!mesh_path.empty())
+  {
+    try
+    {
+      area_share = total / Normal_orientation::benchmark::Mesh_sampler(mesh_path).area();
+    }
+    catch(const std::exception& e)
+    {
+      std::fprintf(stderr, "winding_energy: %s\n", e.what());
+      return EXIT_FAILURE;
+    }
+  }
   const double e_ours = energy_per_area(points, ours, areas, total);
   const double e_truth = energy_per_area(points, true_signs, areas, total);
   if(json)
+  {
     std::printf("{\"samples\":%zu,\"stride\":%lld,\"wrong_samples\":%zu,\"energy_oriented\":%.9g,"
-                "\"energy_truth\":%.9g}\n",
+                "\"energy_truth\":%.9g",
                 points.size(), stride, wrong, e_ours, e_truth);
-  else
+    if(area_share >= 0.0)
+      std::printf(",\"area_share\":%.6g", area_share);
+    std::printf("}\n");
+    return EXIT_SUCCESS;
+  }
+  if(area_share >= 0.0)
+    std::printf("areas: %.4f of the mesh's\n", area_share);
     std::printf("samples %zu (stride %lld), wrong %zu; E/A with the oriented signs %.6f, with the true "
                 "signs %.6f: %s\n",
                 points.size(), stride, wrong, e_ours, e_truth,

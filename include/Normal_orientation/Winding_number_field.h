@@ -115,8 +115,12 @@ inline double clipped_voronoi_area(const double* x, const double* y, unsigned in
 ///   area per point of a disc of radius d_k that holds it and its k
 ///   neighbours.  A cloud of a single point gets area 0.
 ///
-/// On a uniform sampling of a closed surface the areas sum to the surface's
-/// area within a few percent.
+/// On a uniform sampling of a smooth closed surface the areas sum to close
+/// to the surface's area, and the sum approaches it as the spacing shrinks.
+/// Where the surface bends or has edges within the neighbourhood, the
+/// neighbours project onto the plane short of where the surface takes them,
+/// and the sum falls short (measured in doc/global_orientation.md, *The
+/// cheese at 4k points: its areas*).
 ///
 /// \tparam ConcurrencyTag `CGAL::Parallel_tag` (kd-tree and cells in parallel
 ///         with TBB) or `CGAL::Sequential_tag`; the areas are the same either way
