@@ -148,7 +148,8 @@ std::vector<double> estimate_point_areas(const std::vector<Point>& points, const
     return areas;
   std::vector<std::uint32_t> nb;
   std::vector<float> d2;
-  const std::vector<std::uint32_t> order = internal::morton_k_nearest_neighbors<ConcurrencyTag, Kernel>(points, k, nb, d2);
+  const std::vector<std::uint32_t> order =
+    internal::morton_k_nearest_neighbors<ConcurrencyTag, Kernel>(points, k, nb, d2);
   std::vector<float>().swap(d2);
   const double pi = 3.14159265358979323846;
   internal::parallel_chunks<ConcurrencyTag>(n, [&](std::size_t sb, std::size_t se) {
