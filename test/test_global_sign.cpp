@@ -1546,6 +1546,7 @@ TEST(Global_sign, LayerEdgesAndCuesFixThinPartsAndContacts)
     double after;
   };
   const Case cases[] = {{"thin_plate", 0.005}, {"thin_pipe", 0.005}, {"thin_dome", 0.005}, {"touching_boxes", 0.03}};
+  std::size_t rounds = 0;
   for (const Case& c : cases) {
     std::mt19937_64 rng(1);
     const std::vector<Sample> s = NO::hard_shapes::hard_shape(c.name, 30000, rng);
@@ -1556,7 +1557,11 @@ TEST(Global_sign, LayerEdgesAndCuesFixThinPartsAndContacts)
                 r.global.layer_pairs, r.global.layer_cues, r.global.layer_cues_against);
     EXPECT_LE(after, c.after) << c.name;
     EXPECT_GE(double(r.global.layer_pairs), (c.after < 0.01 ? 0.8 : 0.1) * n) << c.name;
+    // (the coarse pass's figures outlive the layer cues' round)
+    EXPECT_FALSE(std::isnan(r.global.coherence)) << c.name;
+    rounds += r.global.layer_cue_round ? 1 : 0;
   }
+  EXPECT_GE(rounds, 1u); // (the thin dome's cues ask for a round)
   // A clean closed surface with no thin part: no point on two layers, and
   // no second solve.
   std::mt19937_64 rng(2);

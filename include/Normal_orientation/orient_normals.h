@@ -585,7 +585,9 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         if (round) {
           cue_unary.swap(cue_report.unary);
           want_cues = false;
+          const Global_sign_summary first = result.global;
           fine(solver, true, true); // (cues come only from the dense step: the pass did not run)
+          internal::keep_coarse_report(first, result.global);
         }
         result.global.layer_cues = cue_report.sure;
         result.global.layer_cues_against = cue_report.against;

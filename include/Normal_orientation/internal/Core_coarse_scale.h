@@ -266,6 +266,19 @@ private:
   const std::vector<typename Kernel::Vector_3>& m_normals;
 };
 
+/// After the layer cues' round, whose stage replaced the global summary:
+/// `later` (the round's) takes the coarse pass's figures from `earlier` (the
+/// first round's, with `Coarse_pass::add_report()`), and the seconds of both
+/// stages.  Both drivers call it.
+inline void keep_coarse_report(const Global_sign_summary& earlier, Global_sign_summary& later)
+{
+  later.coherence = earlier.coherence;
+  later.coarse_points = earlier.coarse_points;
+  later.coarse_used = earlier.coarse_used;
+  later.coarse_before_solver = earlier.coarse_before_solver;
+  later.seconds += earlier.seconds;
+}
+
 } // namespace internal
 /// \endcond
 } // namespace Normal_orientation

@@ -371,7 +371,9 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     if (round) { // (`cues` stays: the round does not ask for cues)
       cue_has_unary = cues.segments_with_unary(swept.segment_has_unary, solution.component);
       cue_round = true;
+      const Global_sign_summary first = result.global;
       fine(solver, false, true);
+      Normal_orientation::internal::keep_coarse_report(first, result.global);
     }
     result.global.layer_cues = cues.sure;
     result.global.layer_cues_against = cues.against;
