@@ -163,6 +163,14 @@ inline void check_groups(std::size_t n, const std::vector<double>& areas, const 
       throw std::invalid_argument(std::string(caller) + ": a group id is out of range");
 }
 
+/// Whether a sample of the top surface (`facing` from `top_view_facing()`)
+/// lies within 30 degrees of horizontal: |`facing`| >= cos 30 degrees.
+inline bool near_horizontal_top(double facing) { return std::abs(facing) >= 0.8660254037844386; }
+
+/// The share of a group's near-horizontal top that must face down for
+/// `downward_top_flips()` to negate it.
+constexpr double top_down_share = 0.75;
+
 /// The median of `radius` (not empty), at least the smallest positive double:
 /// the pixel side of the views.
 inline double median_radius(std::vector<double> radius)
@@ -302,7 +310,7 @@ inline std::vector<char> downward_top_flips(const std::vector<double>& facing, c
   std::vector<double> area(eligible.size(), 0.0), top(eligible.size(), 0.0), down(eligible.size(), 0.0);
   for (std::size_t j = 0; j < facing.size(); ++j) {
     area[group[j]] += areas[j];
-    if (std::abs(facing[j]) >= 0.8660254037844386) {
+    if (internal::near_horizontal_top(facing[j])) {
       top[group[j]] += areas[j];
       if (facing[j] < 0.0)
         down[group[j]] += areas[j];
@@ -310,7 +318,8 @@ inline std::vector<char> downward_top_flips(const std::vector<double>& facing, c
   }
   std::vector<char> flip(eligible.size(), 0);
   for (std::size_t g = 0; g < eligible.size(); ++g)
-    flip[g] = eligible[g] && area[g] > 0.0 && top[g] >= minimum_fraction * area[g] && down[g] > 0.75 * top[g];
+    flip[g] = eligible[g] && area[g] > 0.0 && top[g] >= minimum_fraction * area[g] &&
+              down[g] > internal::top_down_share * top[g];
   return flip;
 }
 

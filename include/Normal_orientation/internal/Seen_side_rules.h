@@ -206,11 +206,11 @@ inline bool top_flip_possible(const std::vector<double>& facing, const std::vect
   std::vector<double> area(eligible.size(), 0.0), down(eligible.size(), 0.0);
   for (std::size_t j = 0; j < facing.size(); ++j) {
     area[sample_component[j]] += areas[j];
-    if (facing[j] < 0.0 && std::abs(facing[j]) >= 0.8660254037844386)
+    if (facing[j] < 0.0 && near_horizontal_top(facing[j]))
       down[sample_component[j]] += areas[j];
   }
   for (std::size_t c = 0; c < eligible.size(); ++c)
-    if (eligible[c] && down[c] > 0.5 * 0.75 * top_minimum_fraction * top_agreeing_share * area[c])
+    if (eligible[c] && down[c] > 0.5 * top_down_share * top_minimum_fraction * top_agreeing_share * area[c])
       return true;
   return false;
 }
