@@ -8,6 +8,7 @@
 
 #include <Normal_orientation/Exterior_visibility.h>
 #include <Normal_orientation/Global_sign.h>
+#include <Normal_orientation/internal/Canopy_rule.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/internal/Frustrated_islands.h>
 #include <Normal_orientation/internal/Layer_edges.h>
@@ -980,6 +981,67 @@ TEST(Global_sign, TopSurfacesOfScenesFaceUp)
   given = NO::test::unoriented(bowl, signs);
   NO::orient_normals(given, np.up_direction(Vector(0, 0, 0)));
   EXPECT_EQ(NO::test::count_wrong(bowl, given), 0u);
+}
+
+TEST(Canopy_rule, CellsOfVolumeScatterOnlyAndOpenScenesOnly)
+{
+  // Three patches fed to the coarse pass's grid (neighbour radius 1: the
+  // canopy's cells are 0.5 wide, their blocks 1.5): a blob of random points
+  // with random normals (a crown), a plane with random normals and noise of
+  // a tenth of the radius (a noisy surface), and a plane with one normal.
+  std::mt19937_64 g(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  auto random_unit = [&]() {
+    std::array<double, 3> n{{gauss(g), gauss(g), gauss(g)}};
+    const double l = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    return std::array<double, 3>{{n[0] / l, n[1] / l, n[2] / l}};
+  };
+  NO::internal::Coarse_scale coarse(1.0);
+  for (int i = 0; i < 20000; ++i) {
+    coarse.add({{3.0 * u(g), 3.0 * u(g), 10.0 + 3.0 * u(g)}}, random_unit()); // the blob around (0, 0, 10)
+    coarse.add({{20.0 + 4.0 * u(g), 4.0 * u(g), 0.1 * gauss(g)}}, random_unit()); // the noisy plane
+    coarse.add({{-20.0 + 4.0 * u(g), 4.0 * u(g), 0.0}}, {{0.0, 0.0, 1.0}}); // the clean plane
+  }
+  coarse.decide(60000);
+  const NO::internal::Canopy_cells cells(coarse);
+  EXPECT_GT(cells.size(), 0u);
+  EXPECT_TRUE(cells.contains({{0.0, 0.0, 10.0}}));
+  EXPECT_TRUE(cells.contains({{1.0, -1.5, 9.0}}));
+  for (double x : {-2.0, 0.0, 2.0}) {
+    EXPECT_FALSE(cells.contains({{20.0 + x, x, 0.0}})) << x; // noise at a few spacings is not a volume
+    EXPECT_FALSE(cells.contains({{-20.0 + x, x, 0.0}})) << x;
+  }
+  EXPECT_FALSE(cells.contains({{0.0, 0.0, 30.0}})); // no points
+  const std::array<double, 3> up{{0.0, 0.0, 1.0}};
+  EXPECT_TRUE(cells.faces_down({{0.0, 0.0, 10.0}}, {{0.0, 0.6, -0.8}}, 1, up));
+  EXPECT_FALSE(cells.faces_down({{0.0, 0.0, 10.0}}, {{0.0, 0.6, -0.8}}, -1, up)); // faces up
+  EXPECT_FALSE(cells.faces_down({{0.0, 0.0, 10.0}}, {{0.0, 0.9, -0.43}}, 1, up)); // over 60 degrees from the up line
+  EXPECT_FALSE(cells.faces_down({{20.0, 0.0, 0.0}}, {{0.0, 0.0, -1.0}}, 1, up));
+  EXPECT_EQ(NO::internal::Canopy_cells().size(), 0u);
+  EXPECT_FALSE(NO::internal::Canopy_cells().contains({{0.0, 0.0, 0.0}}));
+
+  // The components where the rule applies: those that read open in the
+  // field, or that the top rule negated, with samples and not fixed.
+  NO::internal::Global_settings settings;
+  settings.orientation = NO::Global_orientation::VISIBILITY_AND_WINDING;
+  const std::vector<double> w{0.5, 0.45, 0.0, 0.1, 0.5, 0.5, 0.0, 0.5};
+  const std::vector<double> areas(w.size(), 1.0);
+  const std::vector<std::uint32_t> component{0, 0, 1, 1, 2, 2, 3, 3}; // (component 4 has no sample)
+  const std::vector<char> top{0, 0, 1, 0, 0}, fixed{0, 1, 0, 0, 0};
+  // (component 3 has half its area at w = 1/2: `closed_fraction`, closed)
+  EXPECT_EQ(NO::internal::open_scene_components(w, areas, component, 5, top, {}, settings),
+            (std::vector<char>{0, 1, 1, 0, 0}));
+  EXPECT_EQ(NO::internal::open_scene_components(w, areas, component, 5, top, fixed, settings),
+            (std::vector<char>{0, 0, 1, 0, 0}));
+  settings.up = {{0.0, 0.0, 0.0}}; // no up direction: no rule
+  EXPECT_EQ(NO::internal::open_scene_components(w, areas, component, 5, top, {}, settings), std::vector<char>(5, 0));
+  settings.up = {{0.0, 0.0, 2.0}};
+  settings.orientation = NO::Global_orientation::WINDING;
+  EXPECT_EQ(NO::internal::open_scene_components(w, areas, component, 5, top, {}, settings), std::vector<char>(5, 0));
+  EXPECT_EQ(NO::internal::canopy_up(settings)[2], 0.0);
+  settings.orientation = NO::Global_orientation::VISIBILITY_AND_WINDING;
+  EXPECT_EQ(NO::internal::canopy_up(settings)[2], 1.0);
 }
 
 TEST(Coarse_scale, NoiseWiderThanTheSpacingIsOrientedAtACoarserScale)

@@ -18,10 +18,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <algorithm>
 #include <iostream>
 #include <limits>
 #include <random>
@@ -1092,6 +1093,76 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
   auto drop = [](const NO::Point_record&) {};
   EXPECT_FALSE(NO::streaming_orient_normals(src, drop, NO::parameters::global_orientation(NO::Global_orientation::NONE))
                  .global.ran);
+}
+
+TEST(Streaming_orient_normals, CanopyFacesUpInBothDrivers)
+{
+  // An airborne scene: flat ground (normals up, random signs) and 12 trees,
+  // each a trunk (a cylinder, radial normals) under a crown of scatter (a
+  // ball of random points with random normals); one component.  The crowns'
+  // normals within 60 degrees of vertical must face up (the canopy rule), in
+  // both drivers (without the rule, the stage leaves many of them down).
+  std::mt19937_64 g(5);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  std::vector<std::pair<Point, Vector>> input;
+  std::vector<int> part; // 0 ground, 1 crown, 2 trunk
+  auto sign = [&]() { return u(g) < 0.5 ? -1.0 : 1.0; };
+  for (int i = 0; i < 12000; ++i) {
+    input.emplace_back(Point(u(g), u(g), 0.0), Vector(0.0, 0.0, sign()));
+    part.push_back(0);
+  }
+  for (int tx = 0; tx < 4; ++tx)
+    for (int ty = 0; ty < 3; ++ty) {
+      const double cx = 0.15 + 0.7 * tx / 3.0 + 0.06 * (u(g) - 0.5), cy = 0.15 + 0.35 * ty + 0.06 * (u(g) - 0.5);
+      for (int i = 0; i < 700;) {
+        const double x = 2.0 * u(g) - 1.0, y = 2.0 * u(g) - 1.0, z = 2.0 * u(g) - 1.0;
+        if (x * x + y * y + z * z > 1.0)
+          continue;
+        Vector n(gauss(g), gauss(g), gauss(g));
+        input.emplace_back(Point(cx + 0.08 * x, cy + 0.08 * y, 0.3 + 0.08 * z), n / std::sqrt(n.squared_length()));
+        part.push_back(1);
+        ++i;
+      }
+      for (int i = 0; i < 300; ++i) {
+        const double a = 2.0 * CGAL_PI * u(g), s = sign();
+        input.emplace_back(Point(cx + 0.012 * std::cos(a), cy + 0.012 * std::sin(a), 0.24 * u(g)),
+                           Vector(s * std::cos(a), s * std::sin(a), 0.0));
+        part.push_back(2);
+      }
+    }
+  // The shares of up-facing normals within 60 degrees of vertical, on the ground and the crowns.
+  auto shares = [&](const std::vector<Vector>& normal) {
+    std::array<double, 2> up{{0.0, 0.0}}, all{{0.0, 0.0}};
+    for (std::size_t i = 0; i < normal.size(); ++i)
+      if (part[i] < 2 && std::abs(normal[i].z()) >= 0.5 * std::sqrt(normal[i].squared_length())) {
+        all[part[i]] += 1.0;
+        up[part[i]] += normal[i].z() > 0.0 ? 1.0 : 0.0;
+      }
+    return std::array<double, 2>{{up[0] / all[0], up[1] / all[1]}};
+  };
+  Rewindable_source src{as_records(input)};
+  std::vector<Vector> streamed(input.size());
+  auto sink = [&](const NO::Point_record& r) { streamed[r.index] = Vector(r.normal[0], r.normal[1], r.normal[2]); };
+  const NO::Streaming_result sr = NO::streaming_orient_normals(src, sink);
+  auto in_core = input;
+  const NO::Orientation_result rc = NO::orient_normals(in_core, pn_params());
+  std::vector<Vector> core;
+  for (const auto& pn : in_core)
+    core.push_back(pn.second);
+  const std::array<double, 2> s = shares(streamed), c = shares(core);
+  std::printf("canopy: ground up %.4f streamed, %.4f in core; crowns up %.4f streamed, %.4f in core\n", s[0], c[0],
+              s[1], c[1]);
+  EXPECT_GE(s[0], 0.99);
+  EXPECT_GE(c[0], 0.99);
+  EXPECT_GE(s[1], 0.95);
+  EXPECT_GE(c[1], 0.95);
+  EXPECT_GT(sr.global.canopy_cells, 0u);
+  EXPECT_GT(rc.global.canopy_cells, 0u);
+  EXPECT_GT(rc.global.canopy_points_flipped, 0u);
+  // Without an up direction there is no rule.
+  auto again = input;
+  EXPECT_EQ(NO::orient_normals(again, pn_params().up_direction(Vector(0, 0, 0))).global.canopy_points_flipped, 0u);
 }
 
 namespace {

@@ -72,6 +72,14 @@ inline void print_global(const Normal_orientation::Global_sign_summary& g)
     std::fprintf(stderr, "layer cues: %zu point%s on two layers, %zu sure cue%s, %zu against the stage%s\n",
                  g.layer_pairs, plural(g.layer_pairs), g.layer_cues, plural(g.layer_cues), g.layer_cues_against,
                  g.layer_cue_round ? "; solved again with them" : "");
+  if (g.ran && g.canopy_cells > 0) { // (points are counted in core only)
+    std::fprintf(stderr, "canopy: %zu cell%s of volume scatter in scenes seen from above", g.canopy_cells,
+                 plural(g.canopy_cells));
+    if (g.canopy_points_flipped > 0)
+      std::fprintf(stderr, ", %llu point%s turned up", (unsigned long long)g.canopy_points_flipped,
+                   plural(std::size_t(g.canopy_points_flipped)));
+    std::fprintf(stderr, "\n");
+  }
 }
 
 /// "global": what the global sign stage saw and did (null when it did not run)
@@ -91,6 +99,7 @@ inline void json_global(Json_writer& j, const Normal_orientation::Global_sign_su
   j.key("seen_components_flipped").integer(g.seen_components_flipped);
   j.key("seen_patches_flipped").integer(g.seen_patches_flipped).key("seen_vetoes").integer(g.seen_vetoes);
   j.key("top_components_flipped").integer(g.top_components_flipped);
+  j.key("canopy_cells").integer(g.canopy_cells).key("canopy_points_flipped").integer(g.canopy_points_flipped);
   j.key("layer_pairs").integer(g.layer_pairs).key("layer_cues").integer(g.layer_cues);
   j.key("layer_cues_against").integer(g.layer_cues_against).key("layer_cue_round").boolean(g.layer_cue_round);
   j.key("sharp_samples").integer(g.sharp_samples).key("islands_flipped").integer(g.islands_flipped);

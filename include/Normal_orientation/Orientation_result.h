@@ -30,6 +30,11 @@ struct Global_sign_summary
   std::size_t seen_patches_flipped = 0;    ///< sheets (in core) or segments (streamed) negated so, after their components
   std::size_t seen_vetoes = 0;             ///< sheets (streamed: segments) where the winding number's flips against both the solver and visibility were undone
   std::size_t top_components_flipped = 0;  ///< components negated last because their top surface faced down (`top_side_flips()`)
+  /// the cells of the canopy rule (scatter that fills a volume, in a scene
+  /// seen from above, faces up: the manual's *The canopy faces up*), 0
+  /// where the rule does not run
+  std::size_t canopy_cells = 0;
+  std::uint64_t canopy_points_flipped = 0; ///< points the canopy rule negated (in core; 0 streamed)
   unsigned int rounds = 0;             ///< rounds of patch flips
   /// the points whose k nearest neighbours lie on two layers closer than
   /// the neighbour distance (a thin part, or a contact), whose edges across

@@ -37,6 +37,7 @@
 #include <functional>
 #include <initializer_list>
 #include <iterator>
+#include <memory>
 #include <sstream>
 #include <stdexcept>
 #include <string>
@@ -527,6 +528,9 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         internal::Accepts_core_unary<std::decay_t<decltype(solver)>, decltype(weight), decltype(label_map)>::value;
       bool want_cues = cues_possible && policies.global.orientation != Global_orientation::NONE;
       internal::Layer_cue_report cue_report;
+      std::vector<std::uint32_t> final_component; // (of the last `fine`; `open_scene` per component, for the
+      std::vector<char> open_scene;               // canopy rule, with the cells of the coarse pass's grid)
+      std::shared_ptr<const internal::Canopy_cells> canopy;
       auto fine = [&](const auto& the_solver, bool, bool dense) {
         internal::Global_settings global = policies.global;
         global.dense_samples = dense && !coarse_cloud;
@@ -553,14 +557,16 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
           result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(
             graph, in.points, in.normals, component, gr.radius, has_unary, cued, cue_fixed, moved, global, labels,
             &layer_pairs, want_cues && dense ? &cue_report : nullptr, // (no cues where noise hides the layers)
-            &layer_gaps);
+            &layer_gaps, &open_scene);
           result.seconds.global += result.global.seconds;
         }
+        final_component = std::move(component);
       };
       // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
       constexpr bool coarse_pass = !has_constraints && !has_prior; // (no pass with unary terms)
       if (coarse_pass && policies.global.orientation != Global_orientation::NONE) {
         internal::Core_coarse_pass<ConcurrencyTag, Kernel> pass(in.points, in.normals, gr.radius);
+        canopy = pass.canopy();
         auto orient_coarse = [&](auto& cloud) {
           return orient_normals<ConcurrencyTag>(
                    cloud, internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, policies.global))
@@ -594,6 +600,9 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         result.global.layer_cue_round = round;
       }
       result.global.layer_pairs = layer_pairs.size();
+      // 7. The canopy rule, last (Canopy_rule.h).
+      internal::core_canopy_rule(canopy.get(), in.points, in.normals, final_component, open_scene, policies.global,
+                                 labels, result.global, result.seconds.global);
       result.energy_after = energy(graph, weight, label_map);
       for (std::size_t q = 0; q < n; ++q)
         input_labels[order[q]] = labels[q];
@@ -605,7 +614,7 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
     return result;
   }
 
-  // 7. Write back: only the sign changes.
+  // 8. Write back: only the sign changes.
   const auto t_out = std::chrono::steady_clock::now();
   result.number_of_flipped = internal::write_back_signs(points, normal_map, input_labels);
   result.seconds.output = internal::seconds_since(t_out);

@@ -257,6 +257,13 @@ public:
   /// what the pass saw and did
   Coarse_scale_report& report() { return m_report; }
 
+  /// the cells, sorted by key after `decide()`
+  const std::vector<Coarse_cell>& cells() const { return m_cells; }
+  /// the side of a cell
+  double cell_size() const { return m_cell; }
+  /// the origin of the grid (the first point added)
+  const std::array<double, 3>& origin() const { return m_origin; }
+
 private:
   std::uint64_t key_of(const double (&q)[3]) const
   {

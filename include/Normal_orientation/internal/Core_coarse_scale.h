@@ -13,6 +13,7 @@
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Orientation_result.h>
+#include <Normal_orientation/internal/Canopy_rule.h>
 #include <Normal_orientation/internal/Coarse_scale.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/internal/Parallel.h>
@@ -134,6 +135,9 @@ public:
   /// whether the input normals disagree enough for the pass to be tried
   bool runs() const { return m_runs; }
 
+  /// the cells of the canopy rule (`Canopy_rule.h`), from the same grid
+  const std::shared_ptr<const Canopy_cells>& canopy() const { return m_canopy; }
+
   /// what the pass measured and did, with the seconds of all its calls
   Coarse_scale_report report() const
   {
@@ -165,6 +169,7 @@ protected:
   {
     m_runs = m_coarse->decide(n);
     m_report = m_coarse->report();
+    m_canopy = std::make_shared<const Canopy_cells>(*m_coarse);
     if (!m_runs)
       m_coarse.reset(); // its grid is not needed any more
   }
@@ -193,6 +198,7 @@ protected:
   double m_seconds = 0.0; ///< of all the calls
 
 private:
+  std::shared_ptr<const Canopy_cells> m_canopy;
   bool m_runs = false, m_oriented = false;
   double m_coarse_closedness = 0.0;
   std::vector<std::array<double, 3>> m_coarse_normals;

@@ -14,6 +14,7 @@
 #include <Normal_orientation/Orientation_problem.h>
 #include <Normal_orientation/Signed_union_find.h>
 #include <Normal_orientation/Winding_number_field.h>
+#include <Normal_orientation/internal/Canopy_rule.h>
 #include <Normal_orientation/internal/Core_layer_cues.h>
 #include <Normal_orientation/internal/Frustrated_islands.h>
 #include <Normal_orientation/internal/Graph_reduction.h>
@@ -532,7 +533,9 @@ inline std::vector<char> core_seen_side_vetoes(const Core_seen_sides& sides,
 /// components with a point of `cue_fixed` (per point, or empty) keep theirs
 /// as a whole (`cue_components()`); no patch joins
 /// points that the solver negated against its start with points that it
-/// kept (`moved`, per point; empty: no start).
+/// kept (`moved`, per point; empty: no start).  With `open_scenes`, the
+/// components where the canopy rule applies (`open_scene_components()`) go
+/// there.
 template <typename ConcurrencyTag, typename Kernel>
 Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                                       const std::vector<typename Kernel::Vector_3>& normals,
@@ -542,7 +545,8 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
                                       const Global_settings& settings,
                                       std::vector<Label>& labels, const Layer_pairs* pairs = nullptr,
                                       Layer_cue_report* cues = nullptr,
-                                      const std::vector<std::uint8_t>* layer_gaps = nullptr)
+                                      const std::vector<std::uint8_t>* layer_gaps = nullptr,
+                                      std::vector<char>* open_scenes = nullptr)
 {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = points.size();
@@ -616,6 +620,9 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
       labels[i] = Label(-labels[i]);
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
+  if (open_scenes) // (for the canopy rule, after the stage: Canopy_rule.h)
+    *open_scenes = open_scene_components(search.values(), samples.areas, samples.component, nc, top,
+                                         component_fixed, settings);
   // 7. The layer cues of the final signs.
   if (cues && pairs) {
     for (std::size_t t = 0; t < ns; ++t)

@@ -11,6 +11,7 @@
 /// signs in the output passes (through `Point_labels::point_flip`).
 
 #include <Normal_orientation/Orientation_result.h>
+#include <Normal_orientation/internal/Canopy_rule.h>
 #include <Normal_orientation/internal/Coarse_scale.h>
 #include <Normal_orientation/internal/Core_coarse_scale.h>
 #include <Normal_orientation/internal/Settings.h>
@@ -101,17 +102,46 @@ public:
 /// summary in `global`; then the pass is tried
 /// (`Stream_coarse_pass`, `orient` as for `Stream_coarse_pass::apply()`).
 /// Adds the pass's figures to `global` and its seconds to `seconds`.
+/// Returns the cells of the canopy rule, read from the pass's grid.
 template <typename Kernel, typename Solver, typename Fine, typename Orient>
-void coarse_stage(Record_file<Swept_record>& records, double radius, std::uint64_t n, const Solver& solver,
-                  const Fine& fine, const Orient& orient, Point_labels& labels,
-                  const std::vector<std::uint32_t>& component, const std::vector<char>& flip_component,
-                  Global_sign_summary& global, double& seconds)
+std::shared_ptr<const Normal_orientation::internal::Canopy_cells>
+coarse_stage(Record_file<Swept_record>& records, double radius, std::uint64_t n, const Solver& solver,
+             const Fine& fine, const Orient& orient, Point_labels& labels, const std::vector<std::uint32_t>& component,
+             const std::vector<char>& flip_component, Global_sign_summary& global, double& seconds)
 {
   Stream_coarse_pass<Kernel> pass(records, radius, n);
   const bool before = Normal_orientation::internal::solve_around_coarse_pass(pass.runs(), solver, fine, [&]() {
     return pass.apply(labels, component, flip_component, global.closedness, orient);
   });
   pass.add_report(before, global, seconds);
+  return pass.canopy();
+}
+
+/// Installs the canopy rule (`Canopy_rule.h`) in `labels`, after every
+/// other decision of the stages: the points of the components of `open`
+/// that `cells` turns up are negated.  `component` is per sweep segment and
+/// `flip_component` the final sign of each component; both, and `cells`,
+/// must outlive the output passes.
+inline void install_canopy_rule(std::shared_ptr<const Normal_orientation::internal::Canopy_cells> cells,
+                                const std::vector<char>& open, const std::array<double, 3>& up,
+                                const std::vector<std::uint32_t>& component, const std::vector<char>& flip_component,
+                                Point_labels& labels)
+{
+  if (!cells || cells->size() == 0 || !Normal_orientation::internal::any_open_scene(open))
+    return;
+  auto previous = std::move(labels.point_flip);
+  const std::vector<std::uint32_t>* segment_component = &component;
+  const std::vector<char>* flips = &flip_component;
+  labels.point_flip = [cells, open, up, previous, segment_component, flips](const Swept_record& s,
+                                                                            std::uint32_t segment, Label label) {
+    const bool flipped = previous ? previous(s, segment, label) : false;
+    const std::uint32_t c = (*segment_component)[s.segment];
+    if (!open[c])
+      return flipped;
+    const Point_record& r = s.record;
+    const int sign = int(label) * (flipped ? -1 : 1) * ((*flips)[c] ? -1 : 1);
+    return flipped != cells->faces_down({{r.position[0], r.position[1], r.position[2]}}, unit_normal(r), sign, up);
+  };
 }
 
 } // namespace internal

@@ -12,6 +12,7 @@
 #include <Normal_orientation/Global_sign.h>
 #include <Normal_orientation/Progress.h>
 #include <Normal_orientation/Winding_number_field.h>
+#include <Normal_orientation/internal/Canopy_rule.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/internal/Layer_gap.h>
 #include <Normal_orientation/streaming/Labelled_records.h>
@@ -372,6 +373,8 @@ void stream_winding_levels(const Global_samples<Kernel>& samples, Winding_patch_
 /// its sample stands for.  With `fixed_by_cues` (the layer cues' round), the
 /// components that `segment_has_unary` fixes are the cues', which the top
 /// surface's rule (`top_side_flips()`) does not leave out, as in core.
+/// With `open_scenes`, the components where the canopy rule applies
+/// (`open_scene_components()`) go there.
 /// The field's smoothing widths are capped at the
 /// samples' layer gaps (`contact_width_caps()`, with `layer_gap_points` of
 /// the `n` points having one).  Memory: the subsample, the units and
@@ -384,7 +387,7 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
                                  const Normal_orientation::internal::Global_settings& settings,
                                  const Progress_reporter& progress, const Unit_inputs& unit_inputs = Unit_inputs(),
                                  Stream_layer_cues* cues = nullptr, double cue_strength = 0.0,
-                                 bool fixed_by_cues = false)
+                                 bool fixed_by_cues = false, std::vector<char>* open_scenes = nullptr)
 {
   typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
   const auto t0 = std::chrono::steady_clock::now();
@@ -484,6 +487,10 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
     settings);
   for (char f : top)
     report.top_components_flipped += f ? 1 : 0;
+  if (open_scenes) // (for the canopy rule: Canopy_rule.h)
+    *open_scenes = Normal_orientation::internal::open_scene_components(
+      search.values(), areas, samples.component, nc, top, fixed_by_cues ? std::vector<char>() : component_fixed,
+      settings);
   if (cues) {
     std::vector<char> final_flip(ns);
     for (std::size_t j = 0; j < ns; ++j)

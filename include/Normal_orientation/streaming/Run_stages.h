@@ -292,6 +292,8 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
   Segment_solution solution;
   Point_labels labels;
   std::vector<char> flip_component;
+  std::vector<char> open_scene; // (per component, for the canopy rule)
+  std::shared_ptr<const Normal_orientation::internal::Canopy_cells> canopy;
   Labelled_reader points(records, labels);
   // Layer cues (Stream_layer_cues.h): not with the user's unary terms; a
   // second solve with them as unary terms of the sweep's segments when they
@@ -349,7 +351,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
                                                    Unit_inputs{edges.get(), result.edge_span,
                                                                settings.temporary_directory},
                                                    want_cues && dense && !cue_round ? &cues : nullptr, double(k),
-                                                   cue_round);
+                                                   cue_round, &open_scene);
       result.seconds.global += seconds_since(t);
     }
   };
@@ -360,8 +362,8 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
                cloud, Normal_orientation::internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, global))
         .global.closedness;
     };
-    coarse_stage<Kernel>(records, radius, n, solver, fine, orient_coarse, labels, solution.component, flip_component,
-                         result.global, result.seconds.global);
+    canopy = coarse_stage<Kernel>(records, radius, n, solver, fine, orient_coarse, labels, solution.component,
+                                  flip_component, result.global, result.seconds.global);
   } else {
     fine(solver, true, true);
   }
@@ -380,6 +382,13 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     result.global.layer_cue_round = round;
   }
   result.global.layer_pairs = swept.two_layer_points;
+  // The canopy rule, last (Canopy_rule.h), unless the coarse signs were
+  // taken (their own stage decided).
+  if (canopy && Normal_orientation::internal::any_open_scene(open_scene) && !result.global.coarse_used) {
+    result.global.canopy_cells = canopy->size();
+    install_canopy_rule(canopy, open_scene, Normal_orientation::internal::canopy_up(global), solution.component,
+                        flip_component, labels);
+  }
   edges.reset(); // removes the edge file
   if (global.orientation != Global_orientation::NONE && labels.point_flip)
     result.energy_after = std::numeric_limits<double>::quiet_NaN(); // (point by point: not measured)
