@@ -60,11 +60,12 @@ public:
   /// the canopy cells of the grid of `coarse`
   explicit Canopy_cells(const Coarse_scale& coarse) : m_origin(coarse.origin()), m_cell(2.0 * coarse.cell_size())
   {
-    std::vector<Coarse_cell> merged = merge_pairs(coarse.cells());
+    const std::vector<Coarse_cell> merged = merge_into_doubled_cells(coarse.cells());
     for (const Coarse_cell& c : merged) {
       Coarse_cell block;
-      for_block(merged, c.key, [&](const Coarse_cell& o) { block.add(o); });
-      if (block.count >= canopy_minimum_points && is_volume(block) && !agrees(block))
+      for_coarse_block(merged, c.key, [&](std::size_t j) { block.add(merged[j]); });
+      if (block.count >= canopy_minimum_points && is_volume(block) && block.normals >= 3.0 &&
+          normal_coherence(block) < coarse_coherence_threshold)
         m_keys.push_back(c.key);
     }
   }
@@ -77,11 +78,8 @@ public:
   {
     if (m_keys.empty())
       return false;
-    std::array<std::int64_t, 3> c;
-    const double limit = double(coarse_coordinate_offset);
-    for (int d = 0; d < 3; ++d)
-      c[d] = std::int64_t(std::min(limit, std::max(-limit, std::floor((p[d] - m_origin[d]) / m_cell))));
-    return std::binary_search(m_keys.begin(), m_keys.end(), coarse_key(c));
+    const double q[3] = {p[0] - m_origin[0], p[1] - m_origin[1], p[2] - m_origin[2]};
+    return std::binary_search(m_keys.begin(), m_keys.end(), coarse_point_key(q, m_cell));
   }
 
   /// Whether the point `p`, whose unit (or zero) normal `n` is oriented by
@@ -95,73 +93,14 @@ public:
   }
 
 private:
-  /// the cells of `cells` (sorted by key) merged 2 x 2 x 2, sorted by key
-  static std::vector<Coarse_cell> merge_pairs(const std::vector<Coarse_cell>& cells)
-  {
-    std::vector<Coarse_cell> halved(cells);
-    for (Coarse_cell& c : halved) {
-      std::array<std::int64_t, 3> x = coarse_coordinates(c.key);
-      for (int d = 0; d < 3; ++d)
-        x[d] = x[d] >= 0 ? x[d] / 2 : -((1 - x[d]) / 2); // floor(x / 2)
-      c.key = coarse_key(x);
-    }
-    std::stable_sort(halved.begin(), halved.end(),
-                     [](const Coarse_cell& a, const Coarse_cell& b) { return a.key < b.key; });
-    std::vector<Coarse_cell> merged;
-    for (const Coarse_cell& c : halved)
-      if (!merged.empty() && merged.back().key == c.key)
-        merged.back().add(c);
-      else
-        merged.push_back(c);
-    return merged;
-  }
-
-  /// calls f(cell) for the cells of `cells` (sorted) in the 3 x 3 x 3 block
-  /// around `key`
-  template <typename F>
-  static void for_block(const std::vector<Coarse_cell>& cells, std::uint64_t key, const F& f)
-  {
-    const std::array<std::int64_t, 3> c = coarse_coordinates(key);
-    for (std::int64_t dx = -1; dx <= 1; ++dx)
-      for (std::int64_t dy = -1; dy <= 1; ++dy)
-        for (std::int64_t dz = -1; dz <= 1; ++dz) {
-          const std::array<std::int64_t, 3> x{{c[0] + dx, c[1] + dy, c[2] + dz}};
-          const std::uint64_t k = coarse_key(x);
-          if (coarse_coordinates(k) != x) // clamped: outside the grid
-            continue;
-          const auto it = std::lower_bound(cells.begin(), cells.end(), k,
-                                           [](const Coarse_cell& a, std::uint64_t b) { return a.key < b; });
-          if (it != cells.end() && it->key == k)
-            f(*it);
-        }
-  }
-
   /// whether the points of `b` fill a volume
   static bool is_volume(const Coarse_cell& b)
   {
-    const double m = b.count;
-    const double g[3] = {b.s[0] / m, b.s[1] / m, b.s[2] / m};
-    const std::array<double, 6> cov{{b.ss[0] / m - g[0] * g[0], b.ss[1] / m - g[0] * g[1], b.ss[2] / m - g[0] * g[2],
-                                     b.ss[3] / m - g[1] * g[1], b.ss[4] / m - g[1] * g[2], b.ss[5] / m - g[2] * g[2]}};
     double v[3];
     std::array<double, 3> axis;
-    coarse_eigen(cov, v, 0, axis);
+    coarse_eigen(cell_covariance(b), v, 0, axis);
     const double trace = v[0] + v[1] + v[2];
     return trace > 0.0 && v[0] > canopy_volume_share * trace;
-  }
-
-  /// whether the normals of `b` agree (as the coarse pass's coherence reads them)
-  static bool agrees(const Coarse_cell& b)
-  {
-    if (b.normals < 3.0)
-      return true; // (too few to tell: left alone)
-    std::array<double, 6> m;
-    for (int d = 0; d < 6; ++d)
-      m[d] = b.nn[d] / b.normals;
-    double v[3];
-    std::array<double, 3> axis;
-    coarse_eigen(m, v, 2, axis);
-    return v[2] >= coarse_coherence_threshold;
   }
 
   std::array<double, 3> m_origin{{0.0, 0.0, 0.0}};

@@ -140,6 +140,81 @@ inline void coarse_eigen(const std::array<double, 6>& a, double (&values)[3], in
     axis[d] = e[d][o[which]];
 }
 
+/// The key of the cell of side `cell` holding the point `q` (relative to
+/// the grid's origin; clamped to the grid).
+inline std::uint64_t coarse_point_key(const double (&q)[3], double cell)
+{
+  std::array<std::int64_t, 3> c;
+  const double limit = double(coarse_coordinate_offset);
+  for (int d = 0; d < 3; ++d)
+    c[d] = std::int64_t(std::min(limit, std::max(-limit, std::floor(q[d] / cell))));
+  return coarse_key(c);
+}
+
+/// `cells` merged into cells twice as wide (the coordinates halved, rounded
+/// down), sorted by key; the moments of a merged cell add in the order of
+/// `cells`.
+inline std::vector<Coarse_cell> merge_into_doubled_cells(std::vector<Coarse_cell> cells)
+{
+  for (Coarse_cell& c : cells) {
+    std::array<std::int64_t, 3> x = coarse_coordinates(c.key);
+    for (int d = 0; d < 3; ++d)
+      x[d] = x[d] >= 0 ? x[d] / 2 : -((1 - x[d]) / 2); // floor(x / 2)
+    c.key = coarse_key(x);
+  }
+  std::stable_sort(cells.begin(), cells.end(), [](const Coarse_cell& a, const Coarse_cell& b) { return a.key < b.key; });
+  std::vector<Coarse_cell> merged;
+  for (const Coarse_cell& c : cells)
+    if (!merged.empty() && merged.back().key == c.key)
+      merged.back().add(c);
+    else
+      merged.push_back(c);
+  return merged;
+}
+
+/// Calls f(index) for the cells of `cells` (sorted by key) in the 3 x 3 x 3
+/// block around `key`.
+template <typename F>
+void for_coarse_block(const std::vector<Coarse_cell>& cells, std::uint64_t key, const F& f)
+{
+  const std::array<std::int64_t, 3> c = coarse_coordinates(key);
+  for (std::int64_t dx = -1; dx <= 1; ++dx)
+    for (std::int64_t dy = -1; dy <= 1; ++dy)
+      for (std::int64_t dz = -1; dz <= 1; ++dz) {
+        const std::array<std::int64_t, 3> x{{c[0] + dx, c[1] + dy, c[2] + dz}};
+        const std::uint64_t k = coarse_key(x);
+        if (coarse_coordinates(k) != x) // clamped: outside the grid
+          continue;
+        const auto it = std::lower_bound(cells.begin(), cells.end(), k,
+                                         [](const Coarse_cell& a, std::uint64_t b) { return a.key < b; });
+        if (it != cells.end() && it->key == k)
+          f(std::size_t(it - cells.begin()));
+      }
+}
+
+/// The covariance of the points of `b` (at least one) about their centroid,
+/// packed as `coarse_eigen()` reads it.
+inline std::array<double, 6> cell_covariance(const Coarse_cell& b)
+{
+  const double m = b.count;
+  const double g[3] = {b.s[0] / m, b.s[1] / m, b.s[2] / m};
+  return {{b.ss[0] / m - g[0] * g[0], b.ss[1] / m - g[0] * g[1], b.ss[2] / m - g[0] * g[2],
+           b.ss[3] / m - g[1] * g[1], b.ss[4] / m - g[1] * g[2], b.ss[5] / m - g[2] * g[2]}};
+}
+
+/// The coherence of the normals of `b` (at least one): the largest
+/// eigenvalue of their mean n n^T.
+inline double normal_coherence(const Coarse_cell& b)
+{
+  std::array<double, 6> m;
+  for (int d = 0; d < 6; ++d)
+    m[d] = b.nn[d] / b.normals;
+  double v[3];
+  std::array<double, 3> axis;
+  coarse_eigen(m, v, 2, axis);
+  return v[2];
+}
+
 /// The coarse-to-fine accumulator (see the file comment).  Feed every point
 /// with `add()` in a fixed order; when `decide()` returns true, orient
 /// `coarse_points()` / `coarse_normals()` and, if the result is to be used,
@@ -265,64 +340,24 @@ public:
   const std::array<double, 3>& origin() const { return m_origin; }
 
 private:
-  std::uint64_t key_of(const double (&q)[3]) const
-  {
-    std::array<std::int64_t, 3> c;
-    const double limit = double(coarse_coordinate_offset);
-    for (int d = 0; d < 3; ++d)
-      c[d] = std::int64_t(std::min(limit, std::max(-limit, std::floor(q[d] / m_cell))));
-    return coarse_key(c);
-  }
+  std::uint64_t key_of(const double (&q)[3]) const { return coarse_point_key(q, m_cell); }
 
   /// doubles the cells, merging their moments (in the order of the keys)
   void coarsen()
   {
     m_cell *= 2.0;
-    for (Coarse_cell& c : m_cells) {
-      std::array<std::int64_t, 3> x = coarse_coordinates(c.key);
-      for (int d = 0; d < 3; ++d)
-        x[d] = x[d] >= 0 ? x[d] / 2 : -((1 - x[d]) / 2); // floor(x / 2)
-      c.key = coarse_key(x);
-    }
-    std::stable_sort(m_cells.begin(), m_cells.end(),
-                     [](const Coarse_cell& a, const Coarse_cell& b) { return a.key < b.key; });
-    std::vector<Coarse_cell> merged;
-    for (const Coarse_cell& c : m_cells)
-      if (!merged.empty() && merged.back().key == c.key)
-        merged.back().add(c);
-      else
-        merged.push_back(c);
-    m_cells.swap(merged);
+    m_cells = merge_into_doubled_cells(std::move(m_cells));
     m_index.clear();
     for (std::size_t i = 0; i < m_cells.size(); ++i)
       m_index.emplace(m_cells[i].key, i);
     m_last = std::size_t(-1);
   }
 
-  /// the index of the cell of `key` in the sorted cells, or -1
-  std::size_t find(std::uint64_t key) const
-  {
-    const auto it = std::lower_bound(m_cells.begin(), m_cells.end(), key,
-                                     [](const Coarse_cell& c, std::uint64_t k) { return c.key < k; });
-    return it != m_cells.end() && it->key == key ? std::size_t(it - m_cells.begin()) : std::size_t(-1);
-  }
-
   /// calls f(index) for the occupied cells of the 3 x 3 x 3 block around `key`
   template <typename F>
   void for_block(std::uint64_t key, const F& f) const
   {
-    const std::array<std::int64_t, 3> c = coarse_coordinates(key);
-    for (std::int64_t dx = -1; dx <= 1; ++dx)
-      for (std::int64_t dy = -1; dy <= 1; ++dy)
-        for (std::int64_t dz = -1; dz <= 1; ++dz) {
-          const std::array<std::int64_t, 3> x{{c[0] + dx, c[1] + dy, c[2] + dz}};
-          const std::uint64_t k = coarse_key(x);
-          if (coarse_coordinates(k) != x) // clamped: outside the grid
-            continue;
-          const std::size_t i = find(k);
-          if (i != std::size_t(-1))
-            f(i);
-        }
+    for_coarse_block(m_cells, key, f);
   }
 
   /// the point-weighted median coherence of the normals of the cells with
@@ -334,13 +369,7 @@ private:
     for (const Coarse_cell& c : m_cells) {
       if (c.normals < 3.0)
         continue;
-      std::array<double, 6> m;
-      for (int d = 0; d < 6; ++d)
-        m[d] = c.nn[d] / c.normals;
-      double v[3];
-      std::array<double, 3> axis;
-      coarse_eigen(m, v, 2, axis);
-      values.emplace_back(v[2], c.normals);
+      values.emplace_back(normal_coherence(c), c.normals);
       weight += c.normals;
     }
     if (values.empty())
@@ -367,14 +396,9 @@ private:
       for_block(c.key, [&](std::size_t j) { b.add(m_cells[j]); });
       if (b.count < 6.0)
         continue;
-      const double m = b.count;
-      const double g[3] = {b.s[0] / m, b.s[1] / m, b.s[2] / m};
-      const std::array<double, 6> cov{{b.ss[0] / m - g[0] * g[0], b.ss[1] / m - g[0] * g[1],
-                                       b.ss[2] / m - g[0] * g[2], b.ss[3] / m - g[1] * g[1],
-                                       b.ss[4] / m - g[1] * g[2], b.ss[5] / m - g[2] * g[2]}};
       double v[3];
       std::array<double, 3> axis;
-      coarse_eigen(cov, v, 0, axis);
+      coarse_eigen(cell_covariance(b), v, 0, axis);
       if (!(v[1] > 0.0) || !std::isfinite(axis[0] + axis[1] + axis[2]))
         continue;
       m_point_of_cell[i] = std::uint32_t(m_points.size());
