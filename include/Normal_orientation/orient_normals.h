@@ -324,6 +324,27 @@ std::size_t write_back_signs(PointRange& points, const NormalMap& normal_map, co
   return flipped;
 }
 
+/// The layer cues' round (step 6): where the cues of `report` negate more
+/// than `layer_cue_round_share` of the `n` points, they become the unary
+/// terms `cue_unary` and `again()` runs the solver and the stage once more,
+/// writing its summary to `global`, whose coarse pass's figures are kept
+/// from the first round.  The cues' figures go to `global`.
+template <typename Again>
+void core_layer_cue_round(Layer_cue_report& report, std::vector<double>& cue_unary, std::size_t n,
+                          Global_sign_summary& global, const Again& again)
+{
+  const bool round = double(report.against) > layer_cue_round_share * double(n);
+  if (round) {
+    cue_unary.swap(report.unary);
+    const Global_sign_summary first = global;
+    again();
+    keep_coarse_report(first, global);
+  }
+  global.layer_cues = report.sure;
+  global.layer_cues_against = report.against;
+  global.layer_cue_round = round;
+}
+
 } // namespace internal
 /// \endcond
 
@@ -565,20 +586,14 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       // Noise wider than the spacing: the signs of a coarser scale (Coarse_scale.h).
       constexpr bool coarse_pass = !has_constraints && !has_prior; // (no pass with unary terms)
       if (coarse_pass && policies.global.orientation != Global_orientation::NONE) {
-        internal::Core_coarse_pass<ConcurrencyTag, Kernel> pass(in.points, in.normals, gr.radius);
-        canopy = pass.canopy();
         auto orient_coarse = [&](auto& cloud) {
           return orient_normals<ConcurrencyTag>(
                    cloud, internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, policies.global))
             .global.closedness;
         };
-        const bool before = internal::solve_around_coarse_pass(pass.runs(), solver, fine, [&]() {
-          const bool taken = pass.apply(labels, result.global.closedness, orient_coarse);
-          if (taken) // (the cues were of the fine labels)
-            cue_report.unary.clear();
-          return taken;
-        });
-        pass.add_report(before, result.global, result.seconds.global);
+        canopy = internal::core_coarse_stage<ConcurrencyTag, Kernel>(
+          in.points, in.normals, gr.radius, solver, fine, orient_coarse, labels, result.global, result.seconds.global,
+          [&]() { cue_report.unary.clear(); }); // (the cues were of the fine labels)
       } else {
         fine(solver, true, true);
       }
@@ -586,19 +601,11 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
       // distance, the far field decides their signs (Layer_cues.h); the
       // solver and the stage run once more with the cues as unary terms when
       // they negate enough points.
-      if (want_cues) {
-        const bool round = double(cue_report.against) > internal::layer_cue_round_share * double(n);
-        if (round) {
-          cue_unary.swap(cue_report.unary);
-          want_cues = false;
-          const Global_sign_summary first = result.global;
+      if (want_cues)
+        internal::core_layer_cue_round(cue_report, cue_unary, n, result.global, [&]() {
+          want_cues = false;        // (the round asks for no cues)
           fine(solver, true, true); // (cues come only from the dense step: the pass did not run)
-          internal::keep_coarse_report(first, result.global);
-        }
-        result.global.layer_cues = cue_report.sure;
-        result.global.layer_cues_against = cue_report.against;
-        result.global.layer_cue_round = round;
-      }
+        });
       result.global.layer_pairs = layer_pairs.size();
       // 7. The canopy rule, last (Canopy_rule.h).
       internal::core_canopy_rule(canopy.get(), in.points, in.normals, final_component, open_scene, policies.global,

@@ -272,6 +272,33 @@ private:
   const std::vector<typename Kernel::Vector_3>& m_normals;
 };
 
+/// The coarse-to-fine pass around the solve of the in-core driver
+/// (`solve_around_coarse_pass()`), as `streaming::internal::coarse_stage()`
+/// is for the stream: `fine(solver, improve, dense)` solves and runs what
+/// follows up to the global stage, which leaves its summary in `global`;
+/// then `Core_coarse_pass` is tried against that labelling of `labels`
+/// (`orient` as for `Coarse_pass::take_coarse()`), and `taken()` is called
+/// when the coarse signs are taken.  Adds the pass's figures to `global` and
+/// its seconds to `seconds`.  Returns the cells of the canopy rule, read
+/// from the pass's grid.
+template <typename ConcurrencyTag, typename Kernel, typename Solver, typename Fine, typename Orient, typename Taken>
+std::shared_ptr<const Canopy_cells>
+core_coarse_stage(const std::vector<typename Kernel::Point_3>& points,
+                  const std::vector<typename Kernel::Vector_3>& normals, double radius, const Solver& solver,
+                  const Fine& fine, const Orient& orient, std::vector<Label>& labels, Global_sign_summary& global,
+                  double& seconds, const Taken& taken)
+{
+  Core_coarse_pass<ConcurrencyTag, Kernel> pass(points, normals, radius);
+  const bool before = solve_around_coarse_pass(pass.runs(), solver, fine, [&]() {
+    const bool used = pass.apply(labels, global.closedness, orient);
+    if (used)
+      taken();
+    return used;
+  });
+  pass.add_report(before, global, seconds);
+  return pass.canopy();
+}
+
 /// After the layer cues' round, whose stage replaced the global summary:
 /// `later` (the round's) takes the coarse pass's figures from `earlier` (the
 /// first round's, with `Coarse_pass::add_report()`), and the seconds of both
