@@ -22,6 +22,7 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -1093,6 +1094,38 @@ TEST(Streaming_orient_normals, GlobalStageAsInCore)
   auto drop = [](const NO::Point_record&) {};
   EXPECT_FALSE(NO::streaming_orient_normals(src, drop, NO::parameters::global_orientation(NO::Global_orientation::NONE))
                  .global.ran);
+}
+
+// The streamed global stage reads the next block of points while the units
+// take the last one (`collect_global_samples()`): the output is the same
+// bytes with one thread and with two, over several blocks (32,768 points
+// each) and with the units built.
+TEST(Streaming_orient_normals, GlobalStageSameOutputForOneAndTwoThreads)
+{
+  std::mt19937_64 rng(5);
+  const auto truth = NO::hard_shapes::hard_shape("touching_ellipsoids", 70000, rng);
+  const auto input = unoriented(truth, rng);
+  std::vector<std::vector<NO::Point_record>> out(2);
+  std::vector<NO::Streaming_result> result(2);
+  for (int t = 0; t < 2; ++t) {
+    Rewindable_source src{as_records(input)};
+    auto sink = [&out, t](const NO::Point_record& r) { out[t].push_back(r); };
+    result[t] = NO::streaming_orient_normals(src, sink, NO::parameters::number_of_threads(unsigned(t + 1)));
+  }
+  ASSERT_EQ(out[0].size(), input.size());
+  ASSERT_EQ(out[1].size(), input.size());
+  EXPECT_TRUE(result[0].global.ran);
+  EXPECT_GT(result[0].global.number_of_patches, 0u);
+  EXPECT_EQ(result[0].global.patches_flipped, result[1].global.patches_flipped);
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < input.size(); ++i) {
+    const NO::Point_record& a = out[0][i];
+    const NO::Point_record& b = out[1][i];
+    ASSERT_EQ(a.index, b.index);
+    ASSERT_EQ(std::memcmp(a.normal, b.normal, sizeof(a.normal)), 0) << "point " << a.index;
+    wrong += Vector(a.normal[0], a.normal[1], a.normal[2]) * truth[a.index].n <= 0.0 ? 1 : 0;
+  }
+  EXPECT_LE(double(wrong) / double(input.size()), 0.05);
 }
 
 TEST(Streaming_orient_normals, CanopyFacesUpInBothDrivers)

@@ -14,6 +14,7 @@
 #ifdef CGAL_LINKED_WITH_TBB
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_sort.h>
 #endif
 
@@ -42,6 +43,22 @@ void parallel_chunks(std::size_t n, const F& f, std::size_t grain = 1024)
 #endif
   (void)grain;
   f(std::size_t(0), n);
+}
+
+/// Runs `f()` and `g()`, at the same time when `ConcurrencyTag` is
+/// `CGAL::Parallel_tag` and TBB is linked, else one after the other; an
+/// exception of either is rethrown.
+template <typename ConcurrencyTag, typename F, typename G>
+void parallel_pair(const F& f, const G& g)
+{
+#ifdef CGAL_LINKED_WITH_TBB
+  if (std::is_convertible<ConcurrencyTag, CGAL::Parallel_tag>::value) {
+    tbb::parallel_invoke(f, g);
+    return;
+  }
+#endif
+  f();
+  g();
 }
 
 /// Sorts `v` with `less` (in parallel with TBB); the result is the same for

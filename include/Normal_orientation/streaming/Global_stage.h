@@ -15,6 +15,7 @@
 #include <Normal_orientation/internal/Canopy_rule.h>
 #include <Normal_orientation/internal/Core_global_sign.h>
 #include <Normal_orientation/internal/Layer_gap.h>
+#include <Normal_orientation/internal/Parallel.h>
 #include <Normal_orientation/streaming/Labelled_records.h>
 #include <Normal_orientation/streaming/Patch_units.h>
 #include <Normal_orientation/streaming/Segmenting_sweep.h>
@@ -69,10 +70,65 @@ struct Unit_inputs
   std::string temporary_directory;
 };
 
+/// One read of the labelled points (`Labelled_reader::read()`), copied, with
+/// their signs and unit normals and, for the units, their earlier edges
+/// measured (`Unit_measure`): the first half of the pass of
+/// `collect_global_samples()`.
+struct Unit_block
+{
+  std::vector<Swept_record> records;
+  std::vector<std::uint32_t> segments;
+  std::vector<double> sign;             ///< the oriented normal over the input normal
+  std::vector<std::array<double, 3>> u; ///< the unit input normal
+  std::vector<std::size_t> first_edge;  ///< the edges of point q: [first_edge[q], first_edge[q + 1])
+  std::vector<Earlier_edge> edges;
+  std::vector<Measured_edge> measured_edges;
+  std::vector<Measured_point> measured;
+
+  /// Reads the next points of `points` into this block; with `measure`,
+  /// also their edges from `edge_reader`, measured.  Returns how many (0 at
+  /// the end).
+  std::size_t read(Labelled_reader& points, const std::vector<std::uint32_t>& component,
+                   const std::vector<char>& flip_component, Edge_reader* edge_reader, Unit_measure* measure)
+  {
+    const std::size_t got = points.read();
+    records.assign(points.points().begin(), points.points().end());
+    segments.assign(points.segments().begin(), points.segments().end());
+    sign.resize(got);
+    u.resize(got);
+    first_edge.assign(1, 0);
+    edges.clear();
+    measured.resize(measure ? got : 0);
+    for (std::size_t q = 0; q < got; ++q) {
+      sign[q] = double(points.labels()[q]) * (flip_component[component[records[q].segment]] ? -1.0 : 1.0);
+      u[q] = unit_normal(records[q].record);
+      if (measure) {
+        const Earlier_edge* point_edges = nullptr;
+        std::size_t count = 0;
+        edge_reader->next(point_edges, count);
+        edges.insert(edges.end(), point_edges, point_edges + count);
+      }
+      first_edge.push_back(edges.size());
+    }
+    measured_edges.resize(edges.size());
+    for (std::size_t q = 0; q < got && measure; ++q) {
+      const double* x = records[q].record.position;
+      measured[q] = measure->measure(
+        Patch_units::Kernel::Point_3(x[0], x[1], x[2]),
+        Patch_units::Kernel::Vector_3(sign[q] * u[q][0], sign[q] * u[q][1], sign[q] * u[q][2]),
+        edges.data() + first_edge[q], first_edge[q + 1] - first_edge[q], measured_edges.data() + first_edge[q]);
+    }
+    return got;
+  }
+};
+
 /// One pass: the samples.  With `units`, the same pass pushes every point
 /// into `units`, with its earlier edges from `edges`, and appends its unit
-/// to `unit_file`.
-template <typename Kernel>
+/// to `unit_file`.  The next block is read and measured (`Unit_block`)
+/// while the units take the last one, at the same time with
+/// `CGAL::Parallel_tag`: the units are those of pushing the points one by
+/// one.
+template <typename ConcurrencyTag, typename Kernel>
 Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std::vector<std::uint32_t>& component,
                                               const std::vector<char>& flip_component, std::uint64_t stride,
                                               Patch_units* units = nullptr, Record_file<Earlier_edge>* edges = nullptr,
@@ -81,32 +137,30 @@ Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std
   Global_samples<Kernel> out;
   points.rewind();
   std::unique_ptr<Edge_reader> edge_reader;
-  if (units)
+  std::unique_ptr<Unit_measure> measure;
+  if (units) {
     edge_reader = std::make_unique<Edge_reader>(*edges, false);
+    measure = std::make_unique<Unit_measure>(units->span(), units->cell_side());
+  }
   std::uint64_t at = 0;
-  while (points.read() > 0) {
-    const std::vector<Swept_record>& buffer = points.points();
-    for (std::size_t q = 0; q < buffer.size(); ++q, ++at) {
-      const Swept_record& s = buffer[q];
+  auto take = [&](const Unit_block& block) {
+    for (std::size_t q = 0; q < block.records.size(); ++q, ++at) {
+      const Swept_record& s = block.records[q];
       const std::uint32_t c = component[s.segment];
-      const double sign = double(points.labels()[q]) * (flip_component[c] ? -1.0 : 1.0);
-      const std::array<double, 3> u = unit_normal(s.record);
+      const double sign = block.sign[q];
+      const std::array<double, 3>& u = block.u[q];
       std::uint32_t unit = 0;
       if (units && !units->overflowed()) { // (after an overflow, the units and their file are dropped)
-        const Earlier_edge* point_edges = nullptr;
-        std::size_t count = 0;
-        edge_reader->next(point_edges, count);
-        unit = units->push(Patch_units::Kernel::Point_3(s.record.position[0], s.record.position[1],
-                                                        s.record.position[2]),
-                           Patch_units::Kernel::Vector_3(sign * u[0], sign * u[1], sign * u[2]),
-                           points.segments()[q], c, point_edges, count, sign < 0.0 ? -1 : 1);
+        const std::size_t e = block.first_edge[q];
+        unit = units->push(block.measured[q], block.measured_edges.data() + e, block.segments[q], c,
+                           block.edges.data() + e, block.first_edge[q + 1] - e, sign < 0.0 ? -1 : 1);
         unit_file->append(unit);
       }
       if (at % stride != 0 || (u[0] == 0.0 && u[1] == 0.0 && u[2] == 0.0))
         continue;
       out.points.emplace_back(s.record.position[0], s.record.position[1], s.record.position[2]);
       out.normals.emplace_back(sign * u[0], sign * u[1], sign * u[2]);
-      out.segment.push_back(points.segments()[q]);
+      out.segment.push_back(block.segments[q]);
       out.component.push_back(c);
       out.unit.push_back(unit);
       out.two_layers.push_back(char(s.layer != 0));
@@ -116,6 +170,17 @@ Global_samples<Kernel> collect_global_samples(Labelled_reader& points, const std
       out.sweep_segment.push_back(s.segment);
       out.sweep_flip.push_back(s.flip < 0 ? -1 : 1);
     }
+  };
+  Unit_block block[2];
+  int current = 0;
+  std::size_t got = block[0].read(points, component, flip_component, edge_reader.get(), measure.get());
+  while (got > 0) {
+    std::size_t next = 0;
+    Normal_orientation::internal::parallel_pair<ConcurrencyTag>(
+      [&]() { next = block[1 - current].read(points, component, flip_component, edge_reader.get(), measure.get()); },
+      [&]() { take(block[current]); });
+    current = 1 - current;
+    got = next;
   }
   if (unit_file)
     unit_file->flush();
@@ -400,8 +465,8 @@ Global_sign_summary global_stage(Labelled_reader& points, Point_labels& labels,
     units = std::make_unique<Patch_units>(unit_inputs.span, unit_cell(radius, stride));
     unit_file = std::make_unique<Record_file<std::uint32_t>>(unit_inputs.temporary_directory, 1 << 16);
   }
-  Global_samples<Kernel> samples = collect_global_samples<Kernel>(points, component, flip_component, stride,
-                                                                  units.get(), unit_inputs.edges, unit_file.get());
+  Global_samples<Kernel> samples = collect_global_samples<ConcurrencyTag, Kernel>(
+    points, component, flip_component, stride, units.get(), unit_inputs.edges, unit_file.get());
   if (units && units->overflowed()) { // (noise: segments of a few points) as without an edge file
     units.reset();
     unit_file.reset();

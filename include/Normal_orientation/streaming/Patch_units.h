@@ -19,6 +19,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <unordered_map>
 #include <utility>
@@ -28,6 +29,94 @@ namespace Normal_orientation {
 namespace streaming {
 /// \cond SKIP_IN_MANUAL
 namespace internal {
+
+/// A point's measures that `Patch_units` reads (`Unit_measure`): whether
+/// it has a normal, and its cell.
+struct Measured_point
+{
+  std::array<std::int32_t, 3> cell{{0, 0, 0}};
+  std::uint64_t packed_cell = 0;
+  bool has_normal = false;
+};
+
+/// The measures of an earlier edge (`Unit_measure`): its slope
+/// (`Normal_orientation::internal::edge_slope()`; 2 when the earlier end
+/// has no normal) and the scalar product of its ends' oriented normals (0
+/// then).  Neither is measured when the later end has no normal.
+struct Measured_edge
+{
+  double slope = 2.0;
+  double dot = 0.0;
+};
+
+/// The geometry of the points pushed in the sweep order, apart from the
+/// units' sequential state, so that a pass can measure the next points
+/// while `Patch_units` takes the last ones: a ring of the last `span`
+/// positions and oriented normals.  Deterministic.
+class Unit_measure
+{
+public:
+  typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
+
+  /// for edges reaching at most `span` points back, cells of side `cell` (> 0)
+  Unit_measure(std::uint64_t span, double cell) : m_span(span), m_cell(cell)
+  {
+    std::size_t size = 1;
+    while (size < std::size_t(span) + 1)
+      size *= 2;
+    m_ring.resize(size);
+  }
+
+  /// Measures the next point: its position `p`, its oriented normal `m`
+  /// (zero: none) and its earlier edges `edges[0 .. count - 1]`, whose
+  /// measures go to `out[0 .. count - 1]` (unless it has no normal).
+  /// \throw std::runtime_error when an edge reaches before the first point or
+  ///        farther back than the span
+  Measured_point measure(const Kernel::Point_3& p, const Kernel::Vector_3& m, const Earlier_edge* edges,
+                         std::size_t count, Measured_edge* out)
+  {
+    Measured_point r;
+    r.has_normal = m != CGAL::NULL_VECTOR;
+    for (std::size_t e = 0; e < count && r.has_normal; ++e) {
+      const Point& o = earlier(edges[e].offset);
+      out[e] = Measured_edge();
+      if (!o.has_normal)
+        continue;
+      out[e].slope = Normal_orientation::internal::edge_slope(p, o.position, m, o.normal);
+      out[e].dot = CGAL::to_double(m * o.normal);
+    }
+    for (int d = 0; d < 3; ++d) {
+      r.cell[d] = std::int32_t(std::max(-1e9, std::min(1e9, std::floor(CGAL::to_double(p[d]) / m_cell))));
+      r.packed_cell = (r.packed_cell << 21) | (std::uint64_t(std::int64_t(r.cell[d])) & 0x1FFFFF);
+    }
+    Point& slot = m_ring[std::size_t(m_at & (m_ring.size() - 1))];
+    slot.position = p;
+    slot.normal = m;
+    slot.has_normal = r.has_normal;
+    ++m_at;
+    return r;
+  }
+
+private:
+  struct Point
+  {
+    Kernel::Point_3 position;
+    Kernel::Vector_3 normal;
+    bool has_normal = false;
+  };
+
+  const Point& earlier(std::uint64_t back) const
+  {
+    if (back == 0 || back > m_at || back > m_span)
+      throw std::runtime_error("streaming_orient_normals: an edge of the edge file reaches beyond its span");
+    return m_ring[std::size_t((m_at - back) & (m_ring.size() - 1))];
+  }
+
+  std::uint64_t m_span;
+  double m_cell;
+  std::uint64_t m_at = 0;
+  std::vector<Point> m_ring;
+};
 
 /// The patch units of the points pushed in the sweep order.  A point joins
 /// the provisional sheet of its earlier neighbours across the edges that
@@ -39,9 +128,10 @@ namespace internal {
 /// other or of each other's opposite; each adjacency keeps the smallest
 /// slope of either kind.  So a patch of the current signs (`patches()`) is
 /// what `build_patches()` would make of the points, except that a unit is
-/// never split.  Memory: the last `span` points, the units, their
-/// adjacencies (at most `maximum_units` units) and the provisional sheets.
-/// Deterministic.
+/// never split.  The points come measured by a `Unit_measure`, which a pass
+/// can run ahead on another thread, or are measured here.  Memory: the last
+/// `span` points, the units, their adjacencies (at most `maximum_units`
+/// units) and the provisional sheets.  Deterministic.
 class Patch_units
 {
 public:
@@ -52,8 +142,12 @@ public:
   /// for edges reaching at most `span` points back, cells of side `cell`
   /// (> 0) and at most `maximum_units` units (beyond, `overflowed()`)
   Patch_units(std::uint64_t span, double cell, std::size_t maximum_units = std::size_t(1) << 18)
-    : m_ring(std::size_t(span) + 1), m_cell(cell), m_maximum_units(maximum_units)
+    : m_span(span), m_cell(cell), m_maximum_units(maximum_units)
   {
+    std::size_t size = 1;
+    while (size < std::size_t(span) + 1)
+      size *= 2;
+    m_ring.resize(size);
   }
 
   /// whether the points needed more than the maximum number of units: then
@@ -69,17 +163,25 @@ public:
   std::uint32_t push(const Kernel::Point_3& p, const Kernel::Vector_3& m, std::uint32_t segment,
                      std::uint32_t component, const Earlier_edge* edges, std::size_t count, int sign = 1)
   {
-    const bool has_normal = m != CGAL::NULL_VECTOR;
+    if (!m_measure)
+      m_measure = std::make_unique<Unit_measure>(m_span, m_cell);
+    m_measured.resize(std::max<std::size_t>(m_measured.size(), count));
+    const Measured_point point = m_measure->measure(p, m, edges, count, m_measured.data());
+    return push(point, m_measured.data(), segment, component, edges, count, sign);
+  }
+
+  /// The next point as `push()` above, measured by a `Unit_measure` of the
+  /// same span and cell side that measured every earlier point: `point`,
+  /// and `measured[0 .. count - 1]` the measures of `edges`.
+  std::uint32_t push(const Measured_point& point, const Measured_edge* measured, std::uint32_t segment,
+                     std::uint32_t component, const Earlier_edge* edges, std::size_t count, int sign = 1)
+  {
+    const bool has_normal = point.has_normal;
     std::uint32_t sheet = no_sheet;
-    double slope[64];
-    const std::size_t kept = std::min<std::size_t>(count, 64);
     for (std::size_t e = 0; e < count && has_normal; ++e) {
       const Point& o = earlier(edges[e].offset);
-      const double s = o.has_normal ? Normal_orientation::internal::edge_slope(p, o.position, m, o.normal) : 2.0;
-      if (e < kept)
-        slope[e] = s;
       if (!o.has_normal || o.component != component ||
-          !Normal_orientation::internal::same_sheet(CGAL::to_double(m * o.normal), float(s), m_split_slope))
+          !Normal_orientation::internal::same_sheet(measured[e].dot, float(measured[e].slope), m_split_slope))
         continue;
       if (sheet == no_sheet)
         sheet = find(o.sheet);
@@ -90,33 +192,37 @@ public:
       sheet = std::uint32_t(m_sheet_parent.size());
       m_sheet_parent.push_back(sheet);
     }
-    const std::uint32_t unit = unit_of(p, segment, sheet, component);
+    const std::uint32_t unit = unit_of(point, segment, sheet, component);
+    std::uint64_t last_pair = ~std::uint64_t(0);
+    Pair* pair = nullptr;
     for (std::size_t e = 0; e < count && has_normal && !m_overflowed; ++e) {
       const Point& o = earlier(edges[e].offset);
       if (!o.has_normal)
         continue;
-      const double s = e < kept ? slope[e] : Normal_orientation::internal::edge_slope(p, o.position, m, o.normal);
+      const double s = measured[e].slope;
       ++m_histogram[std::min<std::size_t>(m_histogram.size() - 1, std::size_t(s * double(m_histogram.size())))];
       if (o.unit == unit)
         continue;
       const std::uint32_t a = std::min(unit, o.unit), b = std::max(unit, o.unit);
-      Pair& pair = m_pairs[(std::uint64_t(a) << 32) | b];
+      const std::uint64_t key = (std::uint64_t(a) << 32) | b;
+      if (key != last_pair) { // (the elements of the map stay where they are)
+        pair = &m_pairs[key];
+        last_pair = key;
+      }
       const float w = edges[e].weight * float(sign * o.sign);
-      pair.coupling += w;
-      pair.magnitude += std::abs(w);
+      pair->coupling += w;
+      pair->magnitude += std::abs(w);
       if (o.component != component || s > Normal_orientation::internal::sheet_slope)
         continue;
-      const double dot = CGAL::to_double(m * o.normal);
+      const double dot = measured[e].dot;
       if (dot > -0.5 && dot < 0.5)
         continue;
-      float& least = pair.least[dot >= 0.5 ? 0 : 1];
+      float& least = pair->least[dot >= 0.5 ? 0 : 1];
       least = std::min(least, float(s));
     }
     if (!m_overflowed)
       ++m_unit_size[unit];
-    Point& slot = m_ring[std::size_t(m_at % m_ring.size())];
-    slot.position = p;
-    slot.normal = m;
+    Point& slot = m_ring[std::size_t(m_at & (m_ring.size() - 1))];
     slot.unit = unit;
     slot.sheet = sheet;
     slot.component = component;
@@ -127,6 +233,10 @@ public:
     return unit;
   }
 
+  /// the span of the edges
+  std::uint64_t span() const { return m_span; }
+  /// the side of the cells
+  double cell_side() const { return m_cell; }
   /// the number of units
   std::size_t number_of_units() const { return m_unit_segment.size(); }
   /// the final segment of every unit
@@ -202,8 +312,6 @@ private:
 
   struct Point
   {
-    Kernel::Point_3 position;
-    Kernel::Vector_3 normal;
     std::uint32_t unit = 0, sheet = 0, component = 0;
     bool has_normal = false;
     signed char sign = 1;
@@ -227,9 +335,9 @@ private:
 
   const Point& earlier(std::uint64_t back) const
   {
-    if (back == 0 || back > m_at || back >= m_ring.size())
+    if (back == 0 || back > m_at || back > m_span)
       throw std::runtime_error("streaming_orient_normals: an edge of the edge file reaches beyond its span");
-    return m_ring[std::size_t((m_at - back) % m_ring.size())];
+    return m_ring[std::size_t((m_at - back) & (m_ring.size() - 1))];
   }
 
   std::uint32_t find(std::uint32_t s)
@@ -246,15 +354,11 @@ private:
     return std::min(a, b);
   }
 
-  std::uint32_t unit_of(const Kernel::Point_3& p, std::uint32_t segment, std::uint32_t sheet, std::uint32_t component)
+  std::uint32_t unit_of(const Measured_point& point, std::uint32_t segment, std::uint32_t sheet,
+                        std::uint32_t component)
   {
-    std::array<std::int32_t, 3> c;
-    std::uint64_t packed = 0;
-    for (int d = 0; d < 3; ++d) {
-      c[d] = std::int32_t(std::max(-1e9, std::min(1e9, std::floor(CGAL::to_double(p[d]) / m_cell))));
-      packed = (packed << 21) | (std::uint64_t(std::int64_t(c[d])) & 0x1FFFFF);
-    }
-    const Key key((std::uint64_t(sheet) << 32) | segment, packed);
+    const std::array<std::int32_t, 3>& c = point.cell;
+    const Key key((std::uint64_t(sheet) << 32) | segment, point.packed_cell);
     if (m_at > 0 && key == m_last_key)
       return m_last_unit;
     if (m_overflowed)
@@ -287,7 +391,10 @@ private:
   }
 
   std::vector<Point> m_ring;
+  std::uint64_t m_span;
   double m_cell;
+  std::unique_ptr<Unit_measure> m_measure; // (for the first `push()`)
+  std::vector<Measured_edge> m_measured;
   std::size_t m_maximum_units;
   bool m_overflowed = false;
   std::uint64_t m_at = 0;
