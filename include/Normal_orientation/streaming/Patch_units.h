@@ -30,6 +30,42 @@ namespace streaming {
 /// \cond SKIP_IN_MANUAL
 namespace internal {
 
+/// The slots of the last `span` points of a pass in the sweep order, whose
+/// earlier edges reach at most `span` points back: the slot of point `at`,
+/// and the point `back` places before it.
+template <typename T>
+class Span_ring
+{
+public:
+  explicit Span_ring(std::uint64_t span) : m_span(span)
+  {
+    std::size_t size = 1; // (a power of two: no division per edge)
+    while (size < std::size_t(span) + 1)
+      size *= 2;
+    m_slots.resize(size);
+  }
+
+  /// the slot of point `at`
+  T& slot(std::uint64_t at) { return m_slots[std::size_t(at & (m_slots.size() - 1))]; }
+
+  /// the point `back` places before point `at`
+  /// \throw std::runtime_error when it is before the first point or farther
+  ///        back than the span
+  const T& earlier(std::uint64_t at, std::uint64_t back) const
+  {
+    if (back == 0 || back > at || back > m_span)
+      throw std::runtime_error("streaming_orient_normals: an edge of the edge file reaches beyond its span");
+    return m_slots[std::size_t((at - back) & (m_slots.size() - 1))];
+  }
+
+  /// the span
+  std::uint64_t span() const { return m_span; }
+
+private:
+  std::uint64_t m_span;
+  std::vector<T> m_slots;
+};
+
 /// A point's measures that `Patch_units` reads (`Unit_measure`): whether
 /// it has a normal, and its cell.
 struct Measured_point
@@ -59,13 +95,7 @@ public:
   typedef CGAL::Exact_predicates_inexact_constructions_kernel Kernel;
 
   /// for edges reaching at most `span` points back, cells of side `cell` (> 0)
-  Unit_measure(std::uint64_t span, double cell) : m_span(span), m_cell(cell)
-  {
-    std::size_t size = 1;
-    while (size < std::size_t(span) + 1)
-      size *= 2;
-    m_ring.resize(size);
-  }
+  Unit_measure(std::uint64_t span, double cell) : m_cell(cell), m_ring(span) {}
 
   /// Measures the next point: its position `p`, its oriented normal `m`
   /// (zero: none) and its earlier edges `edges[0 .. count - 1]`, whose
@@ -78,7 +108,7 @@ public:
     Measured_point r;
     r.has_normal = m != CGAL::NULL_VECTOR;
     for (std::size_t e = 0; e < count && r.has_normal; ++e) {
-      const Point& o = earlier(edges[e].offset);
+      const Point& o = m_ring.earlier(m_at, edges[e].offset);
       out[e] = Measured_edge();
       if (!o.has_normal)
         continue;
@@ -89,7 +119,7 @@ public:
       r.cell[d] = std::int32_t(std::max(-1e9, std::min(1e9, std::floor(CGAL::to_double(p[d]) / m_cell))));
       r.packed_cell = (r.packed_cell << 21) | (std::uint64_t(std::int64_t(r.cell[d])) & 0x1FFFFF);
     }
-    Point& slot = m_ring[std::size_t(m_at & (m_ring.size() - 1))];
+    Point& slot = m_ring.slot(m_at);
     slot.position = p;
     slot.normal = m;
     slot.has_normal = r.has_normal;
@@ -105,17 +135,9 @@ private:
     bool has_normal = false;
   };
 
-  const Point& earlier(std::uint64_t back) const
-  {
-    if (back == 0 || back > m_at || back > m_span)
-      throw std::runtime_error("streaming_orient_normals: an edge of the edge file reaches beyond its span");
-    return m_ring[std::size_t((m_at - back) & (m_ring.size() - 1))];
-  }
-
-  std::uint64_t m_span;
   double m_cell;
   std::uint64_t m_at = 0;
-  std::vector<Point> m_ring;
+  Span_ring<Point> m_ring;
 };
 
 /// The patch units of the points pushed in the sweep order.  A point joins
@@ -142,13 +164,8 @@ public:
   /// for edges reaching at most `span` points back, cells of side `cell`
   /// (> 0) and at most `maximum_units` units (beyond, `overflowed()`)
   Patch_units(std::uint64_t span, double cell, std::size_t maximum_units = std::size_t(1) << 18)
-    : m_span(span), m_cell(cell), m_maximum_units(maximum_units)
-  {
-    std::size_t size = 1;
-    while (size < std::size_t(span) + 1)
-      size *= 2;
-    m_ring.resize(size);
-  }
+    : m_ring(span), m_cell(cell), m_maximum_units(maximum_units)
+  {}
 
   /// whether the points needed more than the maximum number of units: then
   /// the units and their adjacencies stop growing, and are not to be used
@@ -164,7 +181,7 @@ public:
                      std::uint32_t component, const Earlier_edge* edges, std::size_t count, int sign = 1)
   {
     if (!m_measure)
-      m_measure = std::make_unique<Unit_measure>(m_span, m_cell);
+      m_measure = std::make_unique<Unit_measure>(m_ring.span(), m_cell);
     m_measured.resize(std::max<std::size_t>(m_measured.size(), count));
     const Measured_point point = m_measure->measure(p, m, edges, count, m_measured.data());
     return push(point, m_measured.data(), segment, component, edges, count, sign);
@@ -222,7 +239,7 @@ public:
     }
     if (!m_overflowed)
       ++m_unit_size[unit];
-    Point& slot = m_ring[std::size_t(m_at & (m_ring.size() - 1))];
+    Point& slot = m_ring.slot(m_at);
     slot.unit = unit;
     slot.sheet = sheet;
     slot.component = component;
@@ -234,7 +251,7 @@ public:
   }
 
   /// the span of the edges
-  std::uint64_t span() const { return m_span; }
+  std::uint64_t span() const { return m_ring.span(); }
   /// the side of the cells
   double cell_side() const { return m_cell; }
   /// the number of units
@@ -333,12 +350,7 @@ private:
     }
   };
 
-  const Point& earlier(std::uint64_t back) const
-  {
-    if (back == 0 || back > m_at || back > m_span)
-      throw std::runtime_error("streaming_orient_normals: an edge of the edge file reaches beyond its span");
-    return m_ring[std::size_t((m_at - back) & (m_ring.size() - 1))];
-  }
+  const Point& earlier(std::uint64_t back) const { return m_ring.earlier(m_at, back); }
 
   std::uint32_t find(std::uint32_t s)
   {
@@ -390,8 +402,7 @@ private:
     return true;
   }
 
-  std::vector<Point> m_ring;
-  std::uint64_t m_span;
+  Span_ring<Point> m_ring;
   double m_cell;
   std::unique_ptr<Unit_measure> m_measure; // (for the first `push()`)
   std::vector<Measured_edge> m_measured;
