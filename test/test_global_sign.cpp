@@ -1117,6 +1117,48 @@ TEST(Coarse_scale, CleanCloudsAreLeftToTheFinePipeline)
   EXPECT_EQ(r.global.coarse_points, 0u);
 }
 
+TEST(Coarse_scale, GridStartsAtTheFirstPointInMortonOrderInAnyOrder)
+{
+  // The in-core driver adds the points in Morton order; the streamed one in
+  // the sweep's order, with the origin found by `Morton_code` over the
+  // points' box (ties by index).  Both must name the same point, whatever
+  // order the points come in; coincident points test the ties.
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(-3.0, 5.0);
+  std::vector<Point> points;
+  for (int i = 0; i < 5000; ++i)
+    points.emplace_back(u(rng), 0.25 * u(rng), 2.0 * u(rng));
+  points.push_back(points[17]); // (a coincident copy, index 5000)
+  points[40] = points[5000];    // (and one of lower index)
+  const std::uint32_t first = NO::internal::morton_order<CGAL::Sequential_tag>(points).front();
+  std::vector<std::uint32_t> order(points.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::shuffle(order.begin(), order.end(), rng);
+  NO::internal::Morton_code box;
+  for (std::uint32_t i : order) {
+    const double p[3] = {points[i].x(), points[i].y(), points[i].z()};
+    box.add(p);
+  }
+  box.close();
+  std::uint64_t best = ~std::uint64_t(0);
+  std::uint32_t found = 0;
+  for (std::uint32_t i : order) {
+    const double p[3] = {points[i].x(), points[i].y(), points[i].z()};
+    const std::uint64_t c = box.code(p);
+    if (c < best || (c == best && i < found)) {
+      best = c;
+      found = i;
+    }
+  }
+  EXPECT_EQ(found, first);
+  // the origin is set before any point, or not at all
+  NO::internal::Coarse_scale scale(1.0);
+  scale.set_origin({{points[first].x(), points[first].y(), points[first].z()}});
+  scale.add({{0.0, 0.0, 0.0}}, {{0.0, 0.0, 1.0}});
+  EXPECT_EQ(scale.origin()[0], points[first].x());
+  EXPECT_THROW(scale.set_origin({{0.0, 0.0, 0.0}}), std::logic_error);
+}
+
 namespace {
 
 /// Two parallel square layers of `n` points each (jittered grid of spacing

@@ -1192,6 +1192,9 @@ TEST(Streaming_orient_normals, CanopyFacesUpInBothDrivers)
   EXPECT_GE(c[1], 0.95);
   EXPECT_GT(sr.global.canopy_cells, 0u);
   EXPECT_GT(rc.global.canopy_cells, 0u);
+  // one grid for both drivers: the same cells, the same coherence
+  EXPECT_EQ(sr.global.canopy_cells, rc.global.canopy_cells);
+  EXPECT_NEAR(sr.global.coherence, rc.global.coherence, 1e-9);
   EXPECT_GT(rc.global.canopy_points_flipped, 0u);
   // Without an up direction there is no rule.
   auto again = input;

@@ -33,6 +33,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
 #include <type_traits>
 #include <unordered_map>
 #include <utility>
@@ -227,6 +228,19 @@ public:
   /// quarter of it.
   explicit Coarse_scale(double radius) : m_cell(radius > 0.0 && std::isfinite(radius) ? 0.25 * radius : 1.0) {}
 
+  /// Starts the grid at `p`.  Both drivers start it at the first point in
+  /// Morton order (`morton_order()`; ties by input index), so that they read
+  /// the same cells whatever order they add the points in; without it, the
+  /// grid starts at the first point added.
+  /// \throw std::logic_error after an `add()`
+  void set_origin(const std::array<double, 3>& p)
+  {
+    if (!m_cells.empty())
+      throw std::logic_error("Coarse_scale::set_origin: points were added already");
+    m_origin = p;
+    m_has_origin = true;
+  }
+
   /// adds a point and its unit (or zero) normal
   void add(const std::array<double, 3>& p, const std::array<double, 3>& n)
   {
@@ -336,7 +350,7 @@ public:
   const std::vector<Coarse_cell>& cells() const { return m_cells; }
   /// the side of a cell
   double cell_size() const { return m_cell; }
-  /// the origin of the grid (the first point added)
+  /// the origin of the grid (`set_origin()`, else the first point added)
   const std::array<double, 3>& origin() const { return m_origin; }
 
 private:

@@ -221,6 +221,8 @@ public:
     : Base(radius), m_points(points), m_normals(normals)
   {
     const auto t = std::chrono::steady_clock::now();
+    if (!points.empty())
+      this->accumulator().set_origin(position(0)); // (the points are in Morton order; streamed: the same point)
     for (std::size_t i = 0; i < points.size(); ++i)
       this->accumulator().add(position(i), direction(i));
     this->finish(points.size());

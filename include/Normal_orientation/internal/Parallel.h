@@ -87,32 +87,70 @@ inline std::uint64_t spread_bits_3(std::uint64_t x)
   return x;
 }
 
-/// Returns the indices 0..n-1 in Morton (Z-curve) order of the points, ties
-/// broken by index: queries made in this order hit the kd-tree's caches.
+/// The Morton (Z-curve) code of a point in a bounding box: its coordinates
+/// from the box's low corner, scaled so that the longest side spans 21
+/// bits, interleaved.  Grow the box with `add()`, `close()` it, then read
+/// `code()`.
+class Morton_code
+{
+public:
+  /// grows the box to hold `p` (finite)
+  void add(const double p[3])
+  {
+    for (int d = 0; d < 3; ++d) {
+      m_lo[d] = std::min(m_lo[d], p[d]);
+      m_hi[d] = std::max(m_hi[d], p[d]);
+    }
+  }
+  /// fixes the scale, once every point is added
+  void close()
+  {
+    double extent = 0.0;
+    for (int d = 0; d < 3; ++d)
+      extent = std::max(extent, m_hi[d] - m_lo[d]);
+    m_scale = extent > 0.0 ? double((1u << 21) - 1) / extent : 0.0;
+  }
+  /// the code of `p`, which lies in the box (after `close()`)
+  std::uint64_t code(const double p[3]) const
+  {
+    std::uint64_t c = 0;
+    for (int d = 0; d < 3; ++d)
+      c |= spread_bits_3(std::uint64_t((p[d] - m_lo[d]) * m_scale)) << d;
+    return c;
+  }
+
+private:
+  double m_lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
+                    std::numeric_limits<double>::max()};
+  double m_hi[3] = {-std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(),
+                    -std::numeric_limits<double>::max()};
+  double m_scale = 0.0;
+};
+
+/// Returns the indices 0..n-1 in Morton (Z-curve) order of the points
+/// (`Morton_code` over their bounding box), ties broken by index: queries
+/// made in this order hit the kd-tree's caches.
 template <typename ConcurrencyTag, typename Point>
 std::vector<std::uint32_t> morton_order(const std::vector<Point>& points)
 {
   const std::size_t n = points.size();
-  double lo[3] = {std::numeric_limits<double>::max(), std::numeric_limits<double>::max(),
-                  std::numeric_limits<double>::max()};
-  double hi[3] = {-lo[0], -lo[1], -lo[2]};
-  for (const Point& p : points)
-    for (int d = 0; d < 3; ++d) {
-      const double c = CGAL::to_double(p[d]);
-      lo[d] = std::min(lo[d], c);
-      hi[d] = std::max(hi[d], c);
-    }
-  double extent = 0.0;
-  for (int d = 0; d < 3; ++d)
-    extent = std::max(extent, hi[d] - lo[d]);
-  const double scale = extent > 0.0 ? double((1u << 21) - 1) / extent : 0.0;
+  auto coordinates = [&](std::size_t i, double* c) {
+    for (int d = 0; d < 3; ++d)
+      c[d] = CGAL::to_double(points[i][d]);
+  };
+  Morton_code morton;
+  for (std::size_t i = 0; i < n; ++i) {
+    double c[3];
+    coordinates(i, c);
+    morton.add(c);
+  }
+  morton.close();
   std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
   parallel_chunks<ConcurrencyTag>(n, [&](std::size_t b, std::size_t e) {
     for (std::size_t i = b; i < e; ++i) {
-      std::uint64_t code = 0;
-      for (int d = 0; d < 3; ++d)
-        code |= spread_bits_3(std::uint64_t((CGAL::to_double(points[i][d]) - lo[d]) * scale)) << d;
-      keyed[i] = {code, std::uint32_t(i)};
+      double c[3];
+      coordinates(i, c);
+      keyed[i] = {morton.code(c), std::uint32_t(i)};
     }
   });
   parallel_sort<ConcurrencyTag>(keyed, std::less<std::pair<std::uint64_t, std::uint32_t>>());

@@ -31,8 +31,10 @@ namespace streaming {
 namespace internal {
 
 /// The coarse-to-fine pass on the records: the constructor reads them once
-/// into the accumulator and measures whether their input normals agree
-/// (`runs()`: they do not, and the pass is to be tried).  `apply()`, when
+/// into the accumulator, whose grid starts at `origin` (the first point in
+/// Morton order, as in core: `Sweep_stage_result::grid_origin`), and
+/// measures whether their input normals agree (`runs()`: they do not, and
+/// the pass is to be tried).  `apply()`, when
 /// the coarse cloud is more closed than the fine orientation
 /// (`fine_closedness`; `orient` as for
 /// `Normal_orientation::internal::Coarse_pass::take_coarse()`), installs the
@@ -47,9 +49,12 @@ class Stream_coarse_pass : public Normal_orientation::internal::Coarse_pass<Kern
   typedef Normal_orientation::internal::Coarse_scale Coarse_scale;
 
 public:
-  Stream_coarse_pass(Record_file<Swept_record>& records, double radius, std::uint64_t n) : Base(radius)
+  Stream_coarse_pass(Record_file<Swept_record>& records, double radius, const std::array<double, 3>& origin,
+                     std::uint64_t n)
+    : Base(radius)
   {
     const auto t = std::chrono::steady_clock::now();
+    this->accumulator().set_origin(origin);
     records.rewind();
     std::vector<Swept_record> chunk;
     while (true) {
@@ -102,14 +107,16 @@ public:
 /// summary in `global`; then the pass is tried
 /// (`Stream_coarse_pass`, `orient` as for `Stream_coarse_pass::apply()`).
 /// Adds the pass's figures to `global` and its seconds to `seconds`.
-/// Returns the cells of the canopy rule, read from the pass's grid.
+/// Returns the cells of the canopy rule, read from the pass's grid, which
+/// starts at `origin`.
 template <typename Kernel, typename Solver, typename Fine, typename Orient>
 std::shared_ptr<const Normal_orientation::internal::Canopy_cells>
-coarse_stage(Record_file<Swept_record>& records, double radius, std::uint64_t n, const Solver& solver,
+coarse_stage(Record_file<Swept_record>& records, double radius, const std::array<double, 3>& origin,
+             std::uint64_t n, const Solver& solver,
              const Fine& fine, const Orient& orient, Point_labels& labels, const std::vector<std::uint32_t>& component,
              const std::vector<char>& flip_component, Global_sign_summary& global, double& seconds)
 {
-  Stream_coarse_pass<Kernel> pass(records, radius, n);
+  Stream_coarse_pass<Kernel> pass(records, radius, origin, n);
   const bool before = Normal_orientation::internal::solve_around_coarse_pass(pass.runs(), solver, fine, [&]() {
     return pass.apply(labels, component, flip_component, global.closedness, orient);
   });

@@ -112,10 +112,11 @@ inline Progress_reporter stage_progress(const Progress_reporter& p, Stage stage)
 /// The first stages: the scan (count, zero normals, frame or order) and,
 /// when r is not given, its estimate; then the rule of clean positions
 /// (internal/Clean_positions.h) on `criterion`, which the sweep is to use;
-/// returns the number of points.
+/// returns the number of points.  `box` gets their bounding box.
 template <typename ConcurrencyTag, typename Kernel, typename Source, typename FlipCriterion>
 std::uint64_t scan_and_radius_stages(Source& source, const Streaming_settings& settings, int axis, Sweep_frame& frame,
-                                     FlipCriterion& criterion, Streaming_result& result)
+                                     Normal_orientation::internal::Morton_code& box, FlipCriterion& criterion,
+                                     Streaming_result& result)
 {
   using Normal_orientation::internal::seconds_since;
   auto t = std::chrono::steady_clock::now();
@@ -125,6 +126,7 @@ std::uint64_t scan_and_radius_stages(Source& source, const Streaming_settings& s
                                    std::is_same<FlipCriterion, Hoppe_konig_criterion>::value);
   const std::uint64_t n = scanned.number_of_points;
   frame = scanned.frame;
+  box = scanned.box;
   result.number_of_zero_normals = scanned.number_of_zero_normals;
   result.seconds.frame = seconds_since(t);
   if (n == 0)
@@ -191,7 +193,8 @@ void output_stages(Labelled_reader& points, const Segment_solution& solution, co
 /// are rewound.  Fills the sweep's figures of `result`.
 template <typename ConcurrencyTag, typename Kernel, typename Source, typename FlipCriterion, typename Unary>
 Sweep_stage_result sort_and_sweep_stages(Source& source, const Streaming_settings& settings, int axis,
-                                         const Sweep_frame& frame, const FlipCriterion& criterion, const Unary& unary,
+                                         const Sweep_frame& frame, const Normal_orientation::internal::Morton_code& box,
+                                         const FlipCriterion& criterion, const Unary& unary,
                                          std::uint64_t n, Segmenter& segmenter, Record_file<Swept_record>& records,
                                          Record_file<Earlier_edge>* edges, Streaming_result& result)
 {
@@ -212,6 +215,7 @@ Sweep_stage_result sort_and_sweep_stages(Source& source, const Streaming_setting
   const Progress_reporter progress = stage_progress(settings.progress, Stage::SWEEP);
   progress.report(0, n);
   Sweep_stage_result swept;
+  swept.box = box;
   Segmenting_visitor<ConcurrencyTag, Kernel, FlipCriterion, Unary> visitor(
     criterion, unary, segmenter, records, edges, result.neighbor_radius, progress, n, swept, settings.layer_edges);
   Sweep_window<Sweep_payload> window;
@@ -241,6 +245,26 @@ Sweep_stage_result sort_and_sweep_stages(Source& source, const Streaming_setting
   return swept;
 }
 
+/// The refinement of `labels` (`refine_stage()`; no round when the energy
+/// is negligible against `total_weight`, the edges' absolute weights), with
+/// its figures in `result`.
+template <typename ConcurrencyTag, typename Solver>
+void refinement_stage(Record_file<Swept_record>& records, Record_file<Earlier_edge>& edges, std::uint64_t n,
+                      const Streaming_settings& settings, double total_weight, const Solver& solver,
+                      Point_labels& labels, Streaming_result& result)
+{
+  const auto t = std::chrono::steady_clock::now();
+  const unsigned int rounds =
+    settings.refinement.worth_running(result.energy_before_refinement, total_weight) ? settings.refinement.rounds : 0;
+  const Refine_stage_result rr = refine_stage<ConcurrencyTag>(
+    records, edges, n, result.edge_span, settings.refinement, rounds, settings.temporary_directory, solver,
+    result.energy_before_refinement, labels, stage_progress(settings.progress, Stage::REFINE));
+  result.energy_after_refinement = rr.energy_after;
+  result.refinement_rounds_accepted = rr.rounds_accepted;
+  result.refinement_moves = rr.moves;
+  result.seconds.refine = Normal_orientation::internal::seconds_since(t);
+}
+
 /// The stages, run one after the other (see `streaming_orient_normals()`).
 template <typename ConcurrencyTag, typename Kernel, typename Source, typename Sink, typename FlipCriterion,
           typename Solver, typename SignPolicy, typename Unary>
@@ -263,8 +287,10 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
 
   // 1-2. Scan and radius.
   Sweep_frame frame;
+  Normal_orientation::internal::Morton_code box;
   FlipCriterion phi = criterion; // the sweep's (the coarse cloud starts again from `criterion`)
-  const std::uint64_t n = scan_and_radius_stages<ConcurrencyTag, Kernel>(source, settings, axis, frame, phi, result);
+  const std::uint64_t n =
+    scan_and_radius_stages<ConcurrencyTag, Kernel>(source, settings, axis, frame, box, phi, result);
   if (n == 0) {
     component_files.keep();
     return;
@@ -280,8 +306,8 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     edges = std::make_unique<Record_file<Earlier_edge>>(settings.temporary_directory, 1 << 16);
   Segmenter segmenter(settings.thresholds);
   const Sweep_stage_result swept =
-    sort_and_sweep_stages<ConcurrencyTag, Kernel>(source, settings, axis, frame, phi, unary, n, segmenter, records,
-                                                  edges.get(), result);
+    sort_and_sweep_stages<ConcurrencyTag, Kernel>(source, settings, axis, frame, box, phi, unary, n, segmenter,
+                                                  records, edges.get(), result);
   auto t = Clock::now();
 
   // 5-8. The segment graph and its solution, the refinement (skipped when
@@ -319,20 +345,8 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
     labels.segment_labels = solution.labels;
     result.energy_before_refinement = segmenter.point_energy(solution.labels);
     result.energy_after_refinement = result.energy_before_refinement;
-    if (refine && with_refinement && !cue_round) {
-      t = Clock::now();
-      const unsigned int rounds =
-        settings.refinement.worth_running(result.energy_before_refinement, swept.total_weight)
-          ? settings.refinement.rounds
-          : 0;
-      const Refine_stage_result rr = refine_stage<ConcurrencyTag>(
-        records, *edges, n, result.edge_span, settings.refinement, rounds, settings.temporary_directory, the_solver,
-        result.energy_before_refinement, labels, stage(Stage::REFINE));
-      result.energy_after_refinement = rr.energy_after;
-      result.refinement_rounds_accepted = rr.rounds_accepted;
-      result.refinement_moves = rr.moves;
-      result.seconds.refine = seconds_since(t);
-    }
+    if (refine && with_refinement && !cue_round)
+      refinement_stage<ConcurrencyTag>(records, *edges, n, settings, swept.total_weight, the_solver, labels, result);
     result.energy_after = result.energy_after_refinement;
 
     t = Clock::now();
@@ -362,8 +376,8 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
                cloud, Normal_orientation::internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, global))
         .global.closedness;
     };
-    canopy = coarse_stage<Kernel>(records, radius, n, solver, fine, orient_coarse, labels, solution.component,
-                                  flip_component, result.global, result.seconds.global);
+    canopy = coarse_stage<Kernel>(records, radius, swept.grid_origin, n, solver, fine, orient_coarse, labels,
+                                  solution.component, flip_component, result.global, result.seconds.global);
   } else {
     fine(solver, true, true);
   }

@@ -35,6 +35,8 @@ struct Scan_result
   std::uint64_t number_of_points = 0;
   std::uint64_t number_of_zero_normals = 0;
   Sweep_frame frame;         ///< the principal frame (not for a presorted input)
+  /// the bounding box of the points, for their Morton codes
+  Normal_orientation::internal::Morton_code box;
   std::vector<Point> sample; ///< a uniform sample (when the radius is to be estimated)
   /// every record, when asked and there are at most
   /// `clean_positions_maximum_points` (else empty)
@@ -75,6 +77,8 @@ Scan_result<Point> scan(Source& source, int axis, bool sample, const Progress_re
       const bool finite = std::isfinite(r.position[0]) && std::isfinite(r.position[1]) && std::isfinite(r.position[2]);
       if (!finite)
         ++non_finite;
+      else
+        result.box.add(r.position);
       if (r.normal[0] == 0.0 && r.normal[1] == 0.0 && r.normal[2] == 0.0)
         ++result.number_of_zero_normals;
       if (axis >= 0) {
@@ -112,6 +116,7 @@ Scan_result<Point> scan(Source& source, int axis, bool sample, const Progress_re
   if (axis < 0)
     result.frame = moments.frame();
   result.number_of_points = n;
+  result.box.close();
   if (n > Normal_orientation::internal::clean_positions_maximum_points)
     std::vector<Point_record>().swap(result.small_cloud);
   progress.report(n, n);
