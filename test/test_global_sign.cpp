@@ -1120,7 +1120,7 @@ TEST(Coarse_scale, CleanCloudsAreLeftToTheFinePipeline)
 TEST(Coarse_scale, GridStartsAtTheFirstPointInMortonOrderInAnyOrder)
 {
   // The in-core driver adds the points in Morton order; the streamed one in
-  // the sweep's order, with the origin found by `Morton_code` over the
+  // the sweep's order, with the origin found by `Morton_first` over the
   // points' box (ties by index).  Both must name the same point, whatever
   // order the points come in; coincident points test the ties.
   std::mt19937_64 rng(8);
@@ -1140,17 +1140,13 @@ TEST(Coarse_scale, GridStartsAtTheFirstPointInMortonOrderInAnyOrder)
     box.add(p);
   }
   box.close();
-  std::uint64_t best = ~std::uint64_t(0);
-  std::uint32_t found = 0;
+  NO::internal::Morton_first found(box);
   for (std::uint32_t i : order) {
     const double p[3] = {points[i].x(), points[i].y(), points[i].z()};
-    const std::uint64_t c = box.code(p);
-    if (c < best || (c == best && i < found)) {
-      best = c;
-      found = i;
-    }
+    found.add(p, i);
   }
-  EXPECT_EQ(found, first);
+  EXPECT_EQ(found.index(), std::uint64_t(first));
+  EXPECT_EQ(found.position()[1], points[first].y());
   // the origin is set before any point, or not at all
   NO::internal::Coarse_scale scale(1.0);
   scale.set_origin({{points[first].x(), points[first].y(), points[first].z()}});

@@ -19,6 +19,7 @@
 #endif
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -125,6 +126,36 @@ private:
   double m_hi[3] = {-std::numeric_limits<double>::max(), -std::numeric_limits<double>::max(),
                     -std::numeric_limits<double>::max()};
   double m_scale = 0.0;
+};
+
+/// The first of some points in the order of `morton_order()` (by
+/// `Morton_code` over their box, ties by the smaller index), whatever order
+/// they are added in.
+class Morton_first
+{
+public:
+  /// for points in `box` (closed)
+  explicit Morton_first(const Morton_code& box = Morton_code()) : m_box(box) {}
+  /// takes point `p` (in the box), of index `index`
+  void add(const double p[3], std::uint64_t index)
+  {
+    const std::uint64_t code = m_box.code(p);
+    if (code < m_code || (code == m_code && index < m_index)) {
+      m_position = {{p[0], p[1], p[2]}};
+      m_code = code;
+      m_index = index;
+    }
+  }
+  /// the first point's position (zero before any `add()`)
+  const std::array<double, 3>& position() const { return m_position; }
+  /// the first point's index (the largest std::uint64_t before any `add()`)
+  std::uint64_t index() const { return m_index; }
+
+private:
+  Morton_code m_box;
+  std::array<double, 3> m_position{};
+  std::uint64_t m_code = ~std::uint64_t(0);
+  std::uint64_t m_index = ~std::uint64_t(0);
 };
 
 /// Returns the indices 0..n-1 in Morton (Z-curve) order of the points

@@ -34,9 +34,8 @@ namespace internal {
 /// into the accumulator, whose grid starts at `origin` (the first point in
 /// Morton order, as in core: `Sweep_stage_result::grid_origin`), and
 /// measures whether their input normals agree (`runs()`: they do not, and
-/// the pass is to be tried).  `apply()`, when
-/// the coarse cloud is more closed than the fine orientation
-/// (`fine_closedness`; `orient` as for
+/// the pass is to be tried).  `apply()`, when the coarse cloud is more
+/// closed than the fine orientation (`fine_closedness`; `orient` as for
 /// `Normal_orientation::internal::Coarse_pass::take_coarse()`), installs the
 /// coarse signs in `labels` before the global stage's decision, which is kept
 /// for the points without a coarse opinion.  `component` is per sweep

@@ -215,7 +215,7 @@ Sweep_stage_result sort_and_sweep_stages(Source& source, const Streaming_setting
   const Progress_reporter progress = stage_progress(settings.progress, Stage::SWEEP);
   progress.report(0, n);
   Sweep_stage_result swept;
-  swept.box = box;
+  swept.grid_origin = Normal_orientation::internal::Morton_first(box);
   Segmenting_visitor<ConcurrencyTag, Kernel, FlipCriterion, Unary> visitor(
     criterion, unary, segmenter, records, edges, result.neighbor_radius, progress, n, swept, settings.layer_edges);
   Sweep_window<Sweep_payload> window;
@@ -376,7 +376,7 @@ void run_stages(Source& source, Sink& sink, const Streaming_settings& settings, 
                cloud, Normal_orientation::internal::coarse_cloud_parameters<Kernel>(criterion, solver, settings, global))
         .global.closedness;
     };
-    canopy = coarse_stage<Kernel>(records, radius, swept.grid_origin, n, solver, fine, orient_coarse, labels,
+    canopy = coarse_stage<Kernel>(records, radius, swept.grid_origin.position(), n, solver, fine, orient_coarse, labels,
                                   solution.component, flip_component, result.global, result.seconds.global);
   } else {
     fine(solver, true, true);

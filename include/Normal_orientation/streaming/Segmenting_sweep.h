@@ -98,13 +98,10 @@ struct Sweep_stage_result
   double total_weight = 0.0;         ///< the sum of the edges' absolute weights, in the sweep order
   std::uint64_t two_layer_points = 0; ///< points on two layers (`build_neighbor_graph()`)
   std::uint64_t layer_gap_points = 0; ///< points with a layer gap (`build_neighbor_graph()`)
-  /// in: the points' bounding box (`Scan_result`); out: `grid_origin`, the
-  /// first point in Morton order (ties by input index), where the in-core
-  /// driver, which works in that order, starts the coarse grid
-  Normal_orientation::internal::Morton_code box;
-  std::array<double, 3> grid_origin{};
-  std::uint64_t grid_origin_code = ~std::uint64_t(0); ///< its Morton code
-  std::uint64_t grid_origin_index = ~std::uint64_t(0); ///< its input index
+  /// the first point in Morton order (ties by input index), where the
+  /// in-core driver, which works in that order, starts the coarse grid; set
+  /// up over the points' box (`Scan_result::box`) before the sweep
+  Normal_orientation::internal::Morton_first grid_origin;
 };
 
 /// The visitor of `sweep()` for the streaming driver.  `Unary` is callable
@@ -270,15 +267,10 @@ public:
   {
     const Sweep_payload& p = w.payload(s);
     const Point_record& r = w.record(s);
-    const std::uint64_t code = m_out.box.code(r.position);
-    if (code < m_out.grid_origin_code || (code == m_out.grid_origin_code && r.index < m_out.grid_origin_index)) {
-      m_out.grid_origin = {{r.position[0], r.position[1], r.position[2]}};
-      m_out.grid_origin_code = code;
-      m_out.grid_origin_index = r.index;
-    }
+    m_out.grid_origin.add(r.position, r.index);
     m_window_two_layers -= Normal_orientation::internal::is_two_layers(p.layer) ? 1 : 0;
-    m_records.append(Swept_record{w.record(s), p.segment, std::int8_t(p.flip), p.gap,
-                                  layer_code(p.layer, unit_normal(w.record(s)), std::sqrt(m_r2))});
+    m_records.append(Swept_record{r, p.segment, std::int8_t(p.flip), p.gap,
+                                  layer_code(p.layer, unit_normal(r), std::sqrt(m_r2))});
   }
 
 private:
