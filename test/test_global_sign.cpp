@@ -396,6 +396,66 @@ TEST(Global_sign, MovesThatTheStageMostlyUndidAreUndoneInFull)
   EXPECT_EQ(labels, staged);
 }
 
+TEST(Global_sign, MovesThatTheStageNegatedInFullAreTakenBackBeforeItRunsAgain)
+{
+  // The chain of the test above, after the stage and the completion: A
+  // (5-14) and C (32-35) negated in full, B (20-29) in part; the stage also
+  // negated points 0-2, outside every move.  Only B is left as a move.
+  auto chain = [](std::size_t n) {
+    NO::internal::Array_problem problem;
+    problem.number_of_vertices = n;
+    for (std::size_t i = 0; i + 1 < n; ++i) {
+      problem.tail.push_back(std::uint32_t(i));
+      problem.head.push_back(std::uint32_t(i + 1));
+      problem.weight.push_back(1.0);
+    }
+    return NO::internal::Incidence(problem);
+  };
+  const std::size_t n = 40;
+  const NO::internal::Incidence inc = chain(n);
+  auto in = [](std::size_t i, std::size_t a, std::size_t b) { return a <= i && i <= b; };
+  std::vector<char> moved(n, 0);
+  std::vector<NO::Label> before(n, NO::Label(1)), after(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    moved[i] = char(in(i, 5, 14) || in(i, 20, 29) || in(i, 32, 35));
+    before[i] = NO::Label(i % 3 == 0 ? -1 : 1); // (any start)
+    const bool negated = in(i, 0, 2) || in(i, 5, 14) || in(i, 20, 24) || in(i, 32, 35);
+    after[i] = negated ? NO::Label(-before[i]) : before[i];
+  }
+  std::vector<char> remaining;
+  EXPECT_EQ(NO::internal::rejected_moves(inc, moved, {}, before, after, remaining), 2u);
+  ASSERT_EQ(remaining.size(), n);
+  for (std::size_t i = 0; i < n; ++i)
+    EXPECT_EQ(remaining[i], char(in(i, 20, 29))) << i;
+  // A kept point keeps its move: C stays.
+  std::vector<char> keep(n, 0);
+  keep[33] = 1;
+  EXPECT_EQ(NO::internal::rejected_moves(inc, moved, keep, before, after, remaining), 1u);
+  EXPECT_EQ(remaining[33], 1);
+  EXPECT_EQ(remaining[7], 0);
+  // When A and C leave one point each as it was, no move is negated in full.
+  std::vector<NO::Label> partly = after;
+  partly[14] = before[14];
+  partly[35] = before[35];
+  EXPECT_EQ(NO::internal::rejected_moves(inc, moved, {}, before, partly, remaining), 0u);
+  EXPECT_TRUE(remaining.empty());
+  // Without a start, nothing was moved.
+  EXPECT_EQ(NO::internal::rejected_moves(inc, std::vector<char>(), {}, before, after, remaining), 0u);
+  EXPECT_TRUE(remaining.empty());
+  // The same moves on a chain long enough that they hold fewer than
+  // `rejected_move_share` of its points: too small to run again.
+  const std::size_t long_n = std::size_t(24.0 / NO::internal::rejected_move_share) + 100;
+  std::vector<char> long_moved(long_n, 0);
+  std::vector<NO::Label> long_before(long_n, NO::Label(1)), long_after(long_n, NO::Label(1));
+  for (std::size_t i = 0; i < n; ++i) {
+    long_moved[i] = moved[i];
+    long_before[i] = before[i];
+    long_after[i] = after[i];
+  }
+  EXPECT_EQ(NO::internal::rejected_moves(chain(long_n), long_moved, {}, long_before, long_after, remaining), 0u);
+  EXPECT_TRUE(remaining.empty());
+}
+
 TEST(Global_sign, StreamedIslandsAreNegatedOnUnitsAsInCore)
 {
   // The sphere of FrustratedIslandsAreNegatedWhereTheFieldAgrees, pushed

@@ -481,6 +481,30 @@ TEST(Orient_normals, QpboIReducesLargeCloudsAndNeverEndsAboveMst)
             << qpbo.number_of_segments << " segments\n";
 }
 
+TEST(Orient_normals, StageRunsAgainWithoutTheMovesItRejected)
+{
+  // An open box (Hard_shapes.h, true normals, random signs): QPBO-I negates
+  // a large region of the MST's labelling, which the stage negates back in
+  // full.  It then runs again from the MST's labels (Undone_moves.h), so
+  // that the default ends where the MST with the stage does, and with no
+  // more wrong normals.
+  std::mt19937_64 rng(3);
+  const auto truth = NO::hard_shapes::hard_shape("open_box", 30000, rng);
+  const auto input = unoriented(truth, rng);
+  auto a = input, b = input;
+  const NO::Orientation_result qpbo = NO::orient_normals(a, pn_params());
+  const NO::Orientation_result mst = NO::orient_normals(b, pn_params().solver(NO::Mst_solver()));
+  EXPECT_GE(qpbo.global.moves_rejected, 1u);
+  EXPECT_EQ(mst.global.moves_rejected, 0u); // (no start, no moves)
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    differ += a[i].second * b[i].second < 0.0 ? 1 : 0;
+  EXPECT_EQ(differ, 0u);
+  EXPECT_LE(count_wrong(truth, a), count_wrong(truth, b));
+  std::cout << "[ info ] open box: " << qpbo.global.moves_rejected << " moves rejected, " << count_wrong(truth, a)
+            << " wrong (MST " << count_wrong(truth, b) << ")\n";
+}
+
 TEST(Orient_normals, SharedMeshesWhenPresent)
 {
   const std::filesystem::path mesh = std::filesystem::path(NORMAL_ORIENTATION_SHARED_DATA_DIR) / "meshes" / "knot.off";

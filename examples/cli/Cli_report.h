@@ -104,6 +104,7 @@ inline void json_global(Json_writer& j, const Normal_orientation::Global_sign_su
   j.key("layer_cues_against").integer(g.layer_cues_against).key("layer_cue_round").boolean(g.layer_cue_round);
   j.key("sharp_samples").integer(g.sharp_samples).key("islands_flipped").integer(g.islands_flipped);
   j.key("moves_completed").integer(g.moves_completed);
+  j.key("moves_rejected").integer(g.moves_rejected);
   j.key("energy_before").number(g.energy_before).key("energy_after").number(g.energy_after);
   j.key("coherence").number(g.coherence).key("coarse_points").integer(g.coarse_points);
   j.key("coarse_used").boolean(g.coarse_used);

@@ -57,6 +57,11 @@ struct Global_sign_summary
   /// part and then negated in full (the manual's *Moves the stage undid*;
   /// in core only, 0 streamed)
   std::size_t moves_completed = 0;
+  /// the solver's moves that the stage negated in full, after which it ran
+  /// once more from the solver's labels without them, so that no decision
+  /// rests on the field of a move it rejected (the manual's *Moves the
+  /// stage undid*; in core only, 0 streamed)
+  std::size_t moves_rejected = 0;
   /// the fraction of the sampled area where w is within the tolerance of
   /// 1/2, after the stage: near 1 on closed surfaces, low on open scans
   double closedness = std::numeric_limits<double>::quiet_NaN();

@@ -309,6 +309,31 @@ void core_component_signs(const Neighbor_graph& graph, WeightMap weight, const S
       labels[i] = Label(-labels[i]);
 }
 
+/// The global stage of the in-core driver: `stage(moved, restart)` runs it
+/// on `labels`.  When it negated in full moves of the solver that hold at
+/// least `rejected_move_share` of the points (`rejected_moves()`), `labels`
+/// start again from `solved` (the solver's labels) with those moves negated,
+/// `sign()` gives the components their signs, and the stage runs once more
+/// with the moves that remain.  Returns the summary of its last run, with
+/// the figures of both.
+template <typename Stage, typename Sign>
+Global_sign_summary stage_without_rejected_moves(const std::vector<char>& moved, const std::vector<Label>& solved,
+                                                 std::vector<Label>& labels, const Stage& stage, const Sign& sign)
+{
+  Stage_restart restart;
+  const Global_sign_summary first = stage(moved, &restart);
+  if (restart.rejected == 0)
+    return first;
+  for (std::size_t i = 0; i < labels.size(); ++i)
+    labels[i] = moved[i] && !restart.moved[i] ? Label(-solved[i]) : solved[i];
+  sign();
+  Global_sign_summary second = stage(restart.moved, nullptr);
+  second.moves_rejected = restart.rejected;
+  second.moves_completed += first.moves_completed;
+  second.seconds += first.seconds;
+  return second;
+}
+
 /// Negates the normals of `points` whose label in `labels` (in the order of
 /// `points`) is -1; returns how many.  Zero normals are never negated: their
 /// edges weigh 0, so every solver leaves them at +1.
@@ -565,20 +590,29 @@ Orientation_result orient_normals(PointRange& points, const NamedParameters& np 
         result.seconds.solve += internal::seconds_since(t);
         progress.part(Stage::SOLVE, 0.8, 0.9).report(1.0);
 
-        t = std::chrono::steady_clock::now();
         std::vector<std::uint32_t> component;
         std::vector<char> cued, cue_fixed; // (the layer cues' points, and those of the components they fix)
-        internal::core_component_signs(graph, weight, sign_policy, in, gr.radius, has_constraints, cue_unary,
-                                       has_unary, cued, cue_fixed, component, labels, result);
-        result.seconds.sign += internal::seconds_since(t);
+        auto sign = [&](bool again) { // (again: the cues' points back where the solve left them)
+          if (again && !cue_unary.empty())
+            cued.swap(has_unary);
+          t = std::chrono::steady_clock::now();
+          internal::core_component_signs(graph, weight, sign_policy, in, gr.radius, has_constraints, cue_unary,
+                                         has_unary, cued, cue_fixed, component, labels, result);
+          result.seconds.sign += internal::seconds_since(t);
+        };
+        const std::vector<Label> solved = moved.empty() ? std::vector<Label>() : labels; // (for a second run)
+        sign(false);
         progress.part(Stage::SIGN, 0.9, 0.92).report(1.0);
 
         if (policies.global.orientation != Global_orientation::NONE) {
           progress.part(Stage::GLOBAL, 0.92, 1.0).report(0.0);
-          result.global = internal::core_global_signs<ConcurrencyTag, Kernel>(
-            graph, in.points, in.normals, component, gr.radius, has_unary, cued, cue_fixed, moved, global, labels,
-            &layer_pairs, want_cues && dense ? &cue_report : nullptr, // (no cues where noise hides the layers)
-            &layer_gaps, &open_scene);
+          auto stage = [&](const std::vector<char>& the_moved, internal::Stage_restart* r) {
+            return internal::core_global_signs<ConcurrencyTag, Kernel>(
+              graph, in.points, in.normals, component, gr.radius, has_unary, cued, cue_fixed, the_moved, global,
+              labels, &layer_pairs, want_cues && dense ? &cue_report : nullptr, // (none where noise hides the layers)
+              &layer_gaps, &open_scene, r);
+          };
+          result.global = internal::stage_without_rejected_moves(moved, solved, labels, stage, [&]() { sign(true); });
           result.seconds.global += result.global.seconds;
         }
         final_component = std::move(component);

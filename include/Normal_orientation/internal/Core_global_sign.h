@@ -535,7 +535,9 @@ inline std::vector<char> core_seen_side_vetoes(const Core_seen_sides& sides,
 /// points that the solver negated against its start with points that it
 /// kept (`moved`, per point; empty: no start).  With `open_scenes`, the
 /// components where the canopy rule applies (`open_scene_components()`) go
-/// there.
+/// there.  With `restart`, the solver's moves that the stage negated in
+/// full go there (`rejected_moves()`, before the top surface's rule), for
+/// the caller to sign and stage the solver's labels again without them.
 template <typename ConcurrencyTag, typename Kernel>
 Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::vector<typename Kernel::Point_3>& points,
                                       const std::vector<typename Kernel::Vector_3>& normals,
@@ -546,7 +548,7 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
                                       std::vector<Label>& labels, const Layer_pairs* pairs = nullptr,
                                       Layer_cue_report* cues = nullptr,
                                       const std::vector<std::uint8_t>* layer_gaps = nullptr,
-                                      std::vector<char>* open_scenes = nullptr)
+                                      std::vector<char>* open_scenes = nullptr, Stage_restart* restart = nullptr)
 {
   const auto t0 = std::chrono::steady_clock::now();
   const std::size_t n = points.size();
@@ -607,6 +609,8 @@ Global_sign_summary core_global_signs(const Neighbor_graph& graph, const std::ve
   report.islands_flipped = negate_frustrated_islands<ConcurrencyTag, Kernel>(inc, samples.index, keep, search, labels);
   // 5. The solver's moves that the stage undid for the most part are undone in full.
   report.moves_completed = complete_undone_moves(inc, moved, keep, labels_before, labels);
+  if (restart)
+    restart->rejected = rejected_moves(inc, moved, keep, labels_before, labels, restart->moved);
   // 6. Components whose top surface faces down are negated.
   for (std::size_t t = 0; t < ns; ++t)
     samples.oriented[t] = labels[samples.index[t]] < 0 ? -normals[samples.index[t]] : normals[samples.index[t]];
