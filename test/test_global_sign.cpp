@@ -350,13 +350,10 @@ TEST(Global_sign, SheetsMostlyUnseenAreLeftToTheWindingNumber)
   EXPECT_EQ(flips, (std::vector<char>{1, 1, 1, 0, 0}));
 }
 
-TEST(Global_sign, MovesThatTheStageMostlyUndidAreUndoneInFull)
+namespace {
+// The incidence of a chain of `n` points, edges of weight 1.
+NO::internal::Incidence chain_incidence(std::size_t n)
 {
-  // A chain of 40 points.  The solver moved three runs of it: A (5-14),
-  // B (20-29) and C (32-35).  The stage negated 6 points of A, 5 of B and
-  // all of C: only A, more than half undone, is completed.  A kept point
-  // keeps its move as it is, and without a start nothing moves.
-  const std::size_t n = 40;
   NO::internal::Array_problem problem;
   problem.number_of_vertices = n;
   for (std::size_t i = 0; i + 1 < n; ++i) {
@@ -364,7 +361,18 @@ TEST(Global_sign, MovesThatTheStageMostlyUndidAreUndoneInFull)
     problem.head.push_back(std::uint32_t(i + 1));
     problem.weight.push_back(1.0);
   }
-  const NO::internal::Incidence inc(problem);
+  return NO::internal::Incidence(problem);
+}
+} // namespace
+
+TEST(Global_sign, MovesThatTheStageMostlyUndidAreUndoneInFull)
+{
+  // A chain of 40 points.  The solver moved three runs of it: A (5-14),
+  // B (20-29) and C (32-35).  The stage negated 6 points of A, 5 of B and
+  // all of C: only A, more than half undone, is completed.  A kept point
+  // keeps its move as it is, and without a start nothing moves.
+  const std::size_t n = 40;
+  const NO::internal::Incidence inc = chain_incidence(n);
   std::vector<char> moved(n, 0);
   auto in = [](std::size_t i, std::size_t a, std::size_t b) { return a <= i && i <= b; };
   for (std::size_t i = 0; i < n; ++i)
@@ -401,18 +409,8 @@ TEST(Global_sign, MovesThatTheStageNegatedInFullAreTakenBackBeforeItRunsAgain)
   // The chain of the test above, after the stage and the completion: A
   // (5-14) and C (32-35) negated in full, B (20-29) in part; the stage also
   // negated points 0-2, outside every move.  Only B is left as a move.
-  auto chain = [](std::size_t n) {
-    NO::internal::Array_problem problem;
-    problem.number_of_vertices = n;
-    for (std::size_t i = 0; i + 1 < n; ++i) {
-      problem.tail.push_back(std::uint32_t(i));
-      problem.head.push_back(std::uint32_t(i + 1));
-      problem.weight.push_back(1.0);
-    }
-    return NO::internal::Incidence(problem);
-  };
   const std::size_t n = 40;
-  const NO::internal::Incidence inc = chain(n);
+  const NO::internal::Incidence inc = chain_incidence(n);
   auto in = [](std::size_t i, std::size_t a, std::size_t b) { return a <= i && i <= b; };
   std::vector<char> moved(n, 0);
   std::vector<NO::Label> before(n, NO::Label(1)), after(n);
@@ -452,7 +450,7 @@ TEST(Global_sign, MovesThatTheStageNegatedInFullAreTakenBackBeforeItRunsAgain)
     long_before[i] = before[i];
     long_after[i] = after[i];
   }
-  EXPECT_EQ(NO::internal::rejected_moves(chain(long_n), long_moved, {}, long_before, long_after, remaining), 0u);
+  EXPECT_EQ(NO::internal::rejected_moves(chain_incidence(long_n), long_moved, {}, long_before, long_after, remaining), 0u);
   EXPECT_TRUE(remaining.empty());
 }
 
